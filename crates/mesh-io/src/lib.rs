@@ -1,0 +1,67 @@
+//! Triangle meshes for voronoi-fit.
+//!
+//! Entry type: [`TriMesh`]. Entry functions: [`read_mesh`] (any supported format, chosen by
+//! content and extension), [`write_mesh`] / [`write_gltf`] (atomic),
+//! [`TopologyReport::of`] and [`UnitCubeTransform`].
+
+pub mod atomic;
+pub mod error;
+pub mod normalize;
+pub mod read;
+pub mod shapes;
+pub mod topology;
+pub mod weld;
+pub mod write;
+
+pub use atomic::atomic_write;
+pub use error::{ErrorKind, Location, MeshError};
+pub use normalize::UnitCubeTransform;
+pub use read::{read_mesh, read_mesh_from_bytes, Format};
+pub use topology::TopologyReport;
+pub use write::{vertex_normals, write_gltf, write_mesh, write_obj, write_ply, GltfLayout, SceneMesh};
+
+/// An indexed triangle mesh in f64.
+///
+/// - `positions`: #V×3 f64, in the file's own units and frame.
+/// - `triangles`: #F×3 u32, zero-based indices into `positions`, counter-clockwise seen
+///   from outside when the mesh is consistently oriented.
+///
+/// Readers guarantee every coordinate is finite, every index is in range and the mesh has
+/// at least one triangle; code that builds a `TriMesh` by hand can check the same with
+/// [`TriMesh::validate`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl TriMesh {
+    /// Axis-aligned bounding box `(min, max)` of all positions; `([∞;3], [-∞;3])` when
+    /// there are none.
+    pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &self.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Length of the bounding box diagonal (0 for an empty mesh).
+    pub fn diagonal(&self) -> f64 {
+        let (lo, hi) = self.bounding_box();
+        if self.positions.is_empty() {
+            return 0.0;
+        }
+        ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+    }
+
+    /// Check what readers guarantee: finite coordinates, indices in range (the mesh may be
+    /// empty). `what` names the mesh in the error.
+    pub fn validate(&self, what: &std::path::Path) -> Result<(), MeshError> {
+        read::finish(self.clone(), what).map(|_| ()).or_else(|e| if e.kind == ErrorKind::Empty { Ok(()) } else { Err(e) })
+    }
+}

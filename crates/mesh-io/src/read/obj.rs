@@ -1,0 +1,127 @@
+//! Wavefront OBJ through `tobj`, with the checks tobj leaves out.
+//!
+//! tobj parses and triangulates; it accepts empty files, garbage and NaN coordinates, and
+//! its errors carry no line number. After it, this module checks finiteness and emptiness,
+//! and on any problem scans the text once more to name the offending line.
+
+use std::path::Path;
+
+use super::text;
+use crate::error::{ErrorKind, Location, MeshError, Result};
+use crate::TriMesh;
+
+pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
+    let options = tobj::LoadOptions {
+        single_index: false,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let mut reader = std::io::BufReader::new(bytes);
+    // Materials are irrelevant to geometry: a missing .mtl must not fail the load.
+    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed));
+    let (models, _materials) = match loaded {
+        Ok(ok) => ok,
+        Err(e) => return Err(locate(bytes, path, &e.to_string())),
+    };
+
+    let mut mesh = TriMesh::default();
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len();
+        super::check_vertex_count(base + m.positions.len() / 3, path)?;
+        for p in m.positions.chunks_exact(3) {
+            mesh.positions.push([p[0], p[1], p[2]]);
+        }
+        // With `triangulate`, tobj emits triangles only; any arity other than 3 would be a
+        // tobj bug, so check rather than trust it.
+        if m.indices.len() % 3 != 0 {
+            return Err(MeshError::new(
+                ErrorKind::Syntax,
+                path,
+                Location::File,
+                format!("object {:?} did not triangulate into whole triangles", model.name),
+            ));
+        }
+        for t in m.indices.chunks_exact(3) {
+            mesh.triangles.push([t[0] + base as u32, t[1] + base as u32, t[2] + base as u32]);
+        }
+    }
+    if mesh.positions.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(locate(bytes, path, "a vertex coordinate is NaN or infinite"));
+    }
+    if mesh.triangles.is_empty() {
+        let n = text_vertex_count(bytes);
+        return Err(MeshError::new(
+            ErrorKind::Empty,
+            path,
+            Location::File,
+            format!("the file holds no face (it has {n} `v` lines); is it really an OBJ mesh?"),
+        ));
+    }
+    Ok(mesh)
+}
+
+fn text_vertex_count(bytes: &[u8]) -> usize {
+    bytes
+        .split(|&b| b == b'\n')
+        .filter(|l| l.starts_with(b"v ") || l.starts_with(b"v\t"))
+        .count()
+}
+
+/// Find the first line that explains a failure reported by tobj (or by the checks after
+/// it), and build the error for it. Falls back to the whole file with tobj's message.
+fn locate(bytes: &[u8], path: &Path, what: &str) -> MeshError {
+    let lines = match text::lines(bytes, path) {
+        Ok(lines) => lines,
+        Err(e) => return e,
+    };
+    let mut num_positions = 0usize;
+    for (n, line) in lines {
+        let mut toks = line.split_whitespace();
+        match toks.next() {
+            Some("v") => {
+                if let Err(e) = text::parse_point(&mut toks, path, n) {
+                    return e;
+                }
+                num_positions += 1;
+            }
+            Some("f") => {
+                let corners: Vec<&str> = toks.collect();
+                if corners.len() < 3 {
+                    return MeshError::new(
+                        ErrorKind::Syntax,
+                        path,
+                        Location::Line(n),
+                        format!("a face needs at least 3 vertices, this one has {}", corners.len()),
+                    );
+                }
+                for c in corners {
+                    let idx = c.split('/').next().unwrap_or("");
+                    let Ok(i) = idx.parse::<i64>() else {
+                        return MeshError::new(
+                            ErrorKind::Syntax,
+                            path,
+                            Location::Line(n),
+                            format!("face corner {c:?} does not start with a vertex number"),
+                        );
+                    };
+                    let resolved = if i > 0 { i - 1 } else { num_positions as i64 + i };
+                    if i == 0 || resolved < 0 || resolved >= num_positions as i64 {
+                        return MeshError::new(
+                            ErrorKind::IndexOutOfRange,
+                            path,
+                            Location::Line(n),
+                            format!(
+                                "face corner {c:?} refers to vertex {i}, but only {num_positions} vertices are defined before this line"
+                            ),
+                        );
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    MeshError::new(ErrorKind::Syntax, path, Location::File, format!("the OBJ parser failed: {what}"))
+}

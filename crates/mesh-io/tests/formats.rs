@@ -1,0 +1,272 @@
+//! Reading every format, writing every format, and reading back.
+
+use std::path::{Path, PathBuf};
+
+use mesh_io::{read_mesh, shapes, write_gltf, write_mesh, ErrorKind, GltfLayout, Location, SceneMesh, TopologyReport, TriMesh};
+
+fn tmp() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// Same triangles as sets of corner positions, independent of vertex order.
+fn triangle_set(m: &TriMesh) -> Vec<[[u64; 3]; 3]> {
+    let mut v: Vec<[[u64; 3]; 3]> = m
+        .triangles
+        .iter()
+        .map(|t| {
+            // Rotate so the smallest corner comes first; keeps orientation.
+            let c = t.map(|i| m.positions[i as usize].map(f64::to_bits));
+            let k = (0..3).min_by_key(|&k| c[k]).unwrap();
+            [c[k], c[(k + 1) % 3], c[(k + 2) % 3]]
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+fn f32_rounded(m: &TriMesh) -> TriMesh {
+    TriMesh { positions: m.positions.iter().map(|p| p.map(|c| c as f32 as f64)).collect(), triangles: m.triangles.clone() }
+}
+
+#[test]
+fn obj_quads_are_fan_triangulated_and_welded() {
+    let d = tmp();
+    let p = write(d.path(), "q.obj", b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 0\nf 1 2 3 4\nf 5 4 3\n");
+    let m = read_mesh(&p).unwrap();
+    assert_eq!(m.positions.len(), 4, "the duplicate vertex 5 is welded onto vertex 1");
+    assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 3, 2]]);
+}
+
+#[test]
+fn obj_negative_indices_and_missing_mtl() {
+    let d = tmp();
+    let p = write(d.path(), "n.obj", b"mtllib missing.mtl\nusemtl x\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n");
+    assert_eq!(read_mesh(&p).unwrap().triangles, vec![[0, 1, 2]]);
+}
+
+#[test]
+fn every_writer_round_trips_an_icosphere() {
+    let d = tmp();
+    let m = shapes::icosphere(2);
+    for ext in ["obj", "ply", "glb", "gltf"] {
+        let p = d.path().join(format!("s.{ext}"));
+        write_mesh(&p, &m).unwrap();
+        let back = read_mesh(&p).unwrap();
+        let want = if ext.starts_with("gl") { f32_rounded(&m) } else { m.clone() };
+        assert_eq!(triangle_set(&back), triangle_set(&want), "{ext}");
+        assert_eq!(back.positions.len(), m.positions.len(), "{ext}");
+    }
+    // Only the outputs, no temporary files, remain.
+    let mut names: Vec<String> = std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    assert_eq!(names, ["s.bin", "s.glb", "s.gltf", "s.obj", "s.ply"]);
+}
+
+fn stl_binary(m: &TriMesh) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend_from_slice(&(m.triangles.len() as u32).to_le_bytes());
+    for t in &m.triangles {
+        b.extend_from_slice(&[0u8; 12]);
+        for &i in t {
+            for c in m.positions[i as usize] {
+                b.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+        }
+        b.extend_from_slice(&[0, 0]);
+    }
+    b
+}
+
+fn stl_ascii(m: &TriMesh) -> String {
+    let mut s = String::from("solid test\n");
+    for t in &m.triangles {
+        s += "  facet normal 0 0 0\n    outer loop\n";
+        for &i in t {
+            let p = m.positions[i as usize];
+            s += &format!("      vertex {:?} {:?} {:?}\n", p[0], p[1], p[2]);
+        }
+        s += "    endloop\n  endfacet\n";
+    }
+    s + "endsolid test\n"
+}
+
+#[test]
+fn stl_binary_and_ascii_weld_back_to_the_mesh() {
+    let d = tmp();
+    let m = f32_rounded(&shapes::torus(1.0, 0.3, 16, 8));
+    let mut bin = stl_binary(&m);
+    bin[..5].copy_from_slice(b"solid"); // many exporters start binary headers with "solid"
+    for (name, bytes) in [("b.stl", bin), ("a.stl", stl_ascii(&m).into_bytes())] {
+        let back = read_mesh(&write(d.path(), name, &bytes)).unwrap();
+        assert_eq!(back.positions.len(), m.positions.len(), "{name}");
+        assert_eq!(triangle_set(&back), triangle_set(&m), "{name}");
+        let r = TopologyReport::of(&back);
+        assert!(r.is_closed && r.is_manifold && r.is_orientation_consistent, "{name}");
+        assert_eq!(r.genus, Some(1));
+    }
+}
+
+fn ply(m: &TriMesh, format: &str) -> Vec<u8> {
+    let mut b = format!(
+        "ply\nformat {format} 1.0\ncomment test\nelement vertex {}\nproperty float x\nproperty double y\nproperty float z\nproperty uchar red\nelement face {}\nproperty list uchar int vertex_indices\nproperty short flags\nend_header\n",
+        m.positions.len(),
+        m.triangles.len()
+    )
+    .into_bytes();
+    let big = format.ends_with("big_endian");
+    let put = |b: &mut Vec<u8>, mut bytes: Vec<u8>| {
+        if big {
+            bytes.reverse();
+        }
+        b.extend_from_slice(&bytes);
+    };
+    for p in &m.positions {
+        if format == "ascii" {
+            b.extend_from_slice(format!("{:?} {:?} {:?} 7\n", p[0] as f32 as f64, p[1], p[2] as f32 as f64).as_bytes());
+        } else {
+            put(&mut b, (p[0] as f32).to_le_bytes().to_vec());
+            put(&mut b, p[1].to_le_bytes().to_vec());
+            put(&mut b, (p[2] as f32).to_le_bytes().to_vec());
+            b.push(7);
+        }
+    }
+    for t in &m.triangles {
+        if format == "ascii" {
+            b.extend_from_slice(format!("3 {} {} {} -1\n", t[0], t[1], t[2]).as_bytes());
+        } else {
+            b.push(3);
+            for &i in t {
+                put(&mut b, (i as i32).to_le_bytes().to_vec());
+            }
+            put(&mut b, (-1i16).to_le_bytes().to_vec());
+        }
+    }
+    b
+}
+
+#[test]
+fn ply_ascii_little_and_big_endian_agree() {
+    let d = tmp();
+    let m = shapes::icosphere(1);
+    let want = TriMesh {
+        positions: m.positions.iter().map(|p| [p[0] as f32 as f64, p[1], p[2] as f32 as f64]).collect(),
+        triangles: m.triangles.clone(),
+    };
+    for f in ["ascii", "binary_little_endian", "binary_big_endian"] {
+        let back = read_mesh(&write(d.path(), &format!("{f}.ply"), &ply(&m, f))).unwrap();
+        assert_eq!(back, want, "{f}");
+    }
+}
+
+#[test]
+fn off_with_comments_polygons_and_colours() {
+    let d = tmp();
+    let p = write(d.path(), "a.off", b"OFF\n# a square and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n");
+    assert_eq!(read_mesh(&p).unwrap().triangles, vec![[0, 1, 2], [0, 2, 3], [0, 1, 4]]);
+    let p = write(d.path(), "b.off", b"OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    assert_eq!(read_mesh(&p).unwrap().triangles.len(), 1);
+}
+
+#[test]
+fn gltf_scene_with_several_nodes_and_colours_reads_back() {
+    let d = tmp();
+    let a = shapes::icosphere(1);
+    let b = shapes::box_with_hole(1.0, 0.25);
+    let colors = vec![[0.2f32, 0.4, 0.6]; b.positions.len()];
+    let p = d.path().join("scene.glb");
+    write_gltf(
+        &p,
+        &[
+            SceneMesh { name: "a", mesh: &a, colors: None },
+            SceneMesh { name: "empty", mesh: &TriMesh::default(), colors: None },
+            SceneMesh { name: "b", mesh: &b, colors: Some(&colors) },
+        ],
+        GltfLayout::Binary,
+    )
+    .unwrap();
+    let back = read_mesh(&p).unwrap();
+    assert_eq!(back.triangles.len(), a.triangles.len() + b.triangles.len());
+    let r = TopologyReport::of(&back);
+    assert_eq!(r.num_components, 2);
+    assert!(r.is_closed);
+}
+
+/// A glTF written by hand: a node with a mirroring scale (negative determinant) under a
+/// translated parent, and a triangle strip. The reader applies the transforms in f64 and
+/// flips the winding under the mirror.
+#[test]
+fn gltf_node_transforms_and_strips() {
+    use base64::Engine as _;
+    let d = tmp();
+    let mut bin = Vec::new();
+    for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.], [1., 1., 0.]] {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 3] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"translation":[10,0,0],"children":[1]}},{{"scale":[-1,1,1],"mesh":0}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1,"mode":5}}]}}],
+        "buffers":[{{"byteLength":{},"uri":"{uri}"}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":8}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                     {{"bufferView":1,"componentType":5123,"count":4,"type":"SCALAR"}}]}}"#,
+        bin.len()
+    );
+    let m = read_mesh(&write(d.path(), "t.gltf", json.as_bytes())).unwrap();
+    assert_eq!(m.positions, vec![[10.0, 0.0, 0.0], [9.0, 0.0, 0.0], [10.0, 1.0, 0.0], [9.0, 1.0, 0.0]]);
+    // Strip (0,1,2), (2,1,3) — then flipped by the mirror: (0,2,1), (2,3,1).
+    assert_eq!(m.triangles, vec![[0, 2, 1], [2, 3, 1]]);
+}
+
+#[test]
+fn errors_name_the_line_or_element() {
+    let d = tmp();
+    let cases: &[(&str, &[u8], ErrorKind, Location)] = &[
+        ("nan.obj", b"v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", ErrorKind::NonFinite, Location::Line(3)),
+        ("idx.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\n", ErrorKind::IndexOutOfRange, Location::Line(5)),
+        ("garbage.obj", b"hello world\nthis is not a mesh\n", ErrorKind::Empty, Location::File),
+        ("empty.ply", b"", ErrorKind::Empty, Location::File),
+        ("two.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n", ErrorKind::Syntax, Location::Line(6)),
+        ("inf.off", b"OFF\n3 1 0\n0 0 0\n1 inf 0\n0 1 0\n3 0 1 2\n", ErrorKind::NonFinite, Location::Line(4)),
+        ("loop.stl", b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n", ErrorKind::Truncated, Location::Line(3)),
+        ("big.ply", b"ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n", ErrorKind::Truncated, Location::File),
+        ("face.ply", b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", ErrorKind::IndexOutOfRange, Location::Line(13)),
+        ("x.xyz", b"1 2 3\n", ErrorKind::UnknownFormat, Location::File),
+    ];
+    for (name, bytes, kind, loc) in cases {
+        let p = write(d.path(), name, bytes);
+        let e = read_mesh(&p).unwrap_err();
+        assert_eq!((e.kind, &e.location), (*kind, loc), "{name}: {e}");
+        let msg = e.to_string();
+        assert!(msg.starts_with(&p.display().to_string()), "{name}: {msg}");
+    }
+}
+
+#[test]
+fn a_failed_write_leaves_nothing_behind() {
+    let d = tmp();
+    let p = d.path().join("out.obj");
+    std::fs::write(&p, b"old").unwrap();
+    let e = mesh_io::atomic_write(&p, |w| {
+        w.write_all(b"partial")?;
+        Err(std::io::Error::other("simulated disk full"))
+    })
+    .unwrap_err();
+    assert_eq!(e.kind, ErrorKind::Write);
+    assert_eq!(std::fs::read(&p).unwrap(), b"old", "the old file is untouched");
+    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1, "no temporary file remains");
+    let missing_dir = d.path().join("no/such/dir/out.glb");
+    assert_eq!(write_mesh(&missing_dir, &shapes::icosphere(0)).unwrap_err().kind, ErrorKind::Write);
+}

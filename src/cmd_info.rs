@@ -1,0 +1,49 @@
+//! `voronoi-fit info MESH [--json]`: the topology report.
+
+use std::path::PathBuf;
+
+use crate::cli_error::CliError;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Mesh file: .obj, .stl, .ply, .off, .gltf or .glb.
+    pub mesh: PathBuf,
+    /// Print the report as JSON (stable layout, documented in the README).
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: Args) -> Result<(), CliError> {
+    let mesh = mesh_io::read_mesh(&args.mesh)?;
+    let r = mesh_io::TopologyReport::of(&mesh);
+    if args.json {
+        #[derive(serde::Serialize)]
+        struct Out<'a> {
+            file: String,
+            #[serde(flatten)]
+            report: &'a mesh_io::TopologyReport,
+        }
+        let out = Out { file: args.mesh.display().to_string(), report: &r };
+        println!("{}", serde_json::to_string_pretty(&out).map_err(anyhow::Error::from)?);
+        return Ok(());
+    }
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    println!("{}", args.mesh.display());
+    println!("  vertices            {} ({} referenced)", r.num_vertices, r.num_referenced_vertices);
+    println!("  faces               {} ({} degenerate, {} duplicate)", r.num_faces, r.num_degenerate_faces, r.num_duplicate_faces);
+    println!("  edges               {} ({} boundary in {} loops, {} non-manifold)", r.num_edges, r.num_boundary_edges, r.num_boundary_loops, r.num_non_manifold_edges);
+    println!("  non-manifold verts  {}", r.num_non_manifold_vertices);
+    println!("  components          {}", r.num_components);
+    println!("  Euler characteristic {}", r.euler_characteristic);
+    match r.genus {
+        Some(g) => println!("  genus               {g}"),
+        None => println!("  genus               n/a (not closed, manifold and oriented)"),
+    }
+    println!("  closed              {}", yes(r.is_closed));
+    println!("  manifold            {}", yes(r.is_manifold));
+    println!("  consistently oriented {}", yes(r.is_orientation_consistent));
+    println!("  signed volume       {:.9e}", r.signed_volume);
+    println!("  surface area        {:.9e}", r.surface_area);
+    println!("  bounding box        {:?} .. {:?}", r.bbox_min, r.bbox_max);
+    Ok(())
+}

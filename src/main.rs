@@ -1,0 +1,47 @@
+//! `voronoi-fit`: the command-line front end. It parses arguments, wires the library
+//! crates together and maps errors to exit codes; the work happens in `crates/`.
+//!
+//! Exit codes: 0 success, 2 bad input or usage, 1 any other failure.
+
+mod arrays;
+mod cli_error;
+mod cmd_convert;
+mod cmd_info;
+
+use clap::{Parser, Subcommand};
+
+use cli_error::CliError;
+
+#[derive(Parser)]
+#[command(name = "voronoi-fit", version, about = "Turn a triangle mesh into labelled Voronoi sites and back into a watertight crust")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the topology report of a mesh (counts, boundary, manifoldness, genus, volume).
+    Info(cmd_info::Args),
+    /// Convert a mesh to GLB, glTF, OBJ or PLY (optionally normalised into the unit cube).
+    Convert(cmd_convert::Args),
+}
+
+fn main() {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            // Help and version go to stdout with exit 0; usage errors exit 2.
+            let _ = e.print();
+            std::process::exit(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    let result: Result<(), CliError> = match cli.command {
+        Command::Info(args) => cmd_info::run(args),
+        Command::Convert(args) => cmd_convert::run(args),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {e}");
+        std::process::exit(e.exit_code());
+    }
+}

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# The whole test suite, on a fresh machine: the one command the README names and .ci/run
+# calls.
+#
+#   1. a Python venv under target/venv with the pinned reference libraries
+#      (tests/requirements.txt: libigl, trimesh, numpy, scipy, pytest);
+#   2. the Khronos glTF validator (npm gltf-validator) under target/node;
+#   3. cargo test --workspace in the `ci` profile (release speed with debug assertions);
+#   4. the Python reference checks in tests/reference against the built binary.
+#
+# Any failed step fails the run. The last line is `N passed, N failed`.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$(pwd)
+TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
+LOG=$TARGET/test-logs
+mkdir -p "$LOG"
+passed=0
+failed=0
+step_failed=()
+
+note() { printf '\n=== %s\n' "$*"; }
+
+note "Python reference venv ($TARGET/venv)"
+VENV=$TARGET/venv
+stamp=$VENV/.requirements.sha
+want=$(sha256sum tests/requirements.txt | cut -d' ' -f1)
+if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  rm -rf "$VENV"
+  if python3 -m venv "$VENV" && "$VENV/bin/pip" install -q --disable-pip-version-check -r tests/requirements.txt; then
+    echo "$want" > "$stamp"
+  else
+    step_failed+=("python venv")
+  fi
+fi
+
+note "glTF validator ($TARGET/node)"
+NODE_DIR=$TARGET/node
+if [ ! -f "$NODE_DIR/node_modules/gltf-validator/package.json" ] || ! cmp -s tests/package.json "$NODE_DIR/package.json"; then
+  mkdir -p "$NODE_DIR"
+  cp tests/package.json "$NODE_DIR/package.json"
+  (cd "$NODE_DIR" && npm install --no-audit --no-fund --loglevel=error) || step_failed+=("npm install")
+fi
+
+note "cargo test --workspace --profile ci"
+cargo build --profile ci --workspace --bins 2>&1 | tail -n 3
+cargo test --workspace --profile ci --no-fail-fast 2>&1 | tee "$LOG/cargo.log"
+cargo_rc=${PIPESTATUS[0]}
+read -r cp cf < <(awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i+1) ~ /^passed/) p += $i; if ($(i+1) ~ /^failed/) f += $i } } END { print p+0, f+0 }' "$LOG/cargo.log")
+passed=$((passed + cp)); failed=$((failed + cf))
+if [ "$cargo_rc" -ne 0 ] && [ "$cf" -eq 0 ]; then step_failed+=("cargo test (exit $cargo_rc)"); fi
+
+note "Python reference checks (pytest tests/reference)"
+export VF_BIN=$TARGET/ci/voronoi-fit
+export VF_ROOT=$ROOT
+export VF_NODE_DIR=$NODE_DIR
+export VF_SHARED_MESHES=${VF_SHARED_MESHES:-$ROOT/../shared/meshes}
+if [ -x "$VENV/bin/python" ]; then
+  "$VENV/bin/python" -m pytest tests/reference -q -p no:cacheprovider --junitxml="$LOG/pytest.xml" 2>&1 | tee "$LOG/pytest.log"
+  py_rc=${PIPESTATUS[0]}
+  read -r pp pf < <("$VENV/bin/python" - "$LOG/pytest.xml" <<'PY'
+import sys, xml.etree.ElementTree as ET
+try:
+    r = ET.parse(sys.argv[1]).getroot()
+    s = r if r.tag == "testsuite" else r.find("testsuite")
+    t, f, e, k = (int(s.get(a, 0)) for a in ("tests", "failures", "errors", "skipped"))
+    print(t - f - e - k, f + e)
+except Exception:
+    print(0, 0)
+PY
+)
+  passed=$((passed + pp)); failed=$((failed + pf))
+  if [ "$py_rc" -ne 0 ] && [ "$pf" -eq 0 ]; then step_failed+=("pytest (exit $py_rc)"); fi
+else
+  step_failed+=("pytest (no venv)")
+fi
+
+echo
+if [ ${#step_failed[@]} -gt 0 ]; then
+  echo "failed steps: ${step_failed[*]}"
+  failed=$((failed + ${#step_failed[@]}))
+fi
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
