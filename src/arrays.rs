@@ -38,7 +38,10 @@ pub fn read_points_npy(path: &Path) -> Result<Vec<[f64; 3]>, CliError> {
         },
     };
     if a.ncols() != 3 {
-        return Err(bad(path, format!("the array has shape ({}, {}); points must have shape (n, 3).", a.nrows(), a.ncols())));
+        return Err(bad(
+            path,
+            format!("the array has shape ({}, {}); points must have shape (n, 3).", a.nrows(), a.ncols()),
+        ));
     }
     let mut out = Vec::with_capacity(a.nrows());
     for (i, row) in a.rows().into_iter().enumerate() {
@@ -74,7 +77,9 @@ where
     D: Dimension,
 {
     let mut buf = Vec::new();
-    array.write_npy(&mut buf).map_err(|e| CliError::Failure(anyhow!("{}: cannot encode the array ({e})", path.display())))?;
+    array
+        .write_npy(&mut buf)
+        .map_err(|e| CliError::Failure(anyhow!("{}: cannot encode the array ({e})", path.display())))?;
     mesh_io::atomic_write(path, |w| w.write_all(&buf)).map_err(CliError::from)
 }
 
@@ -99,7 +104,11 @@ impl Npz {
     }
 
     pub fn write(self, path: &Path) -> Result<(), CliError> {
-        let bytes = self.writer.finish().map_err(|e| CliError::Failure(anyhow!("{}: cannot finish the npz ({e})", path.display())))?.into_inner();
+        let bytes = self
+            .writer
+            .finish()
+            .map_err(|e| CliError::Failure(anyhow!("{}: cannot finish the npz ({e})", path.display())))?
+            .into_inner();
         mesh_io::atomic_write(path, |w| w.write_all(&bytes)).map_err(CliError::from)
     }
 }

@@ -23,7 +23,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<(), CliError> {
-    if mesh_io::Format::from_extension(&args.output).is_none() || args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl") || e.eq_ignore_ascii_case("off")) {
+    if mesh_io::Format::from_extension(&args.output).is_none()
+        || args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl") || e.eq_ignore_ascii_case("off"))
+    {
         return Err(CliError::BadInput(anyhow!(
             "{}: the output extension names no format this program writes. Use .glb, .gltf, .obj or .ply.",
             args.output.display()
@@ -35,7 +37,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut mesh = mesh_io::read_mesh(&args.mesh)?;
     if args.normalize {
         let t = mesh_io::UnitCubeTransform::of_mesh(&mesh, args.margin).ok_or_else(|| {
-            CliError::BadInput(anyhow!("{}: all vertices coincide, so the mesh cannot be scaled into the unit cube.", args.mesh.display()))
+            CliError::BadInput(anyhow!(
+                "{}: all vertices coincide, so the mesh cannot be scaled into the unit cube.",
+                args.mesh.display()
+            ))
         })?;
         mesh = t.mesh_to_unit(&mesh);
     }

@@ -30,8 +30,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let yes = |b: bool| if b { "yes" } else { "no" };
     println!("{}", args.mesh.display());
     println!("  vertices            {} ({} referenced)", r.num_vertices, r.num_referenced_vertices);
-    println!("  faces               {} ({} degenerate, {} duplicate)", r.num_faces, r.num_degenerate_faces, r.num_duplicate_faces);
-    println!("  edges               {} ({} boundary in {} loops, {} non-manifold)", r.num_edges, r.num_boundary_edges, r.num_boundary_loops, r.num_non_manifold_edges);
+    println!(
+        "  faces               {} ({} degenerate, {} duplicate)",
+        r.num_faces, r.num_degenerate_faces, r.num_duplicate_faces
+    );
+    println!(
+        "  edges               {} ({} boundary in {} loops, {} non-manifold)",
+        r.num_edges, r.num_boundary_edges, r.num_boundary_loops, r.num_non_manifold_edges
+    );
     println!("  non-manifold verts  {}", r.num_non_manifold_vertices);
     println!("  components          {}", r.num_components);
     println!("  Euler characteristic {}", r.euler_characteristic);

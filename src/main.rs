@@ -6,7 +6,10 @@
 mod arrays;
 mod cli_error;
 mod cmd_convert;
+mod cmd_delaunay;
 mod cmd_info;
+mod cmd_query;
+mod cmd_sample;
 
 use clap::{Parser, Subcommand};
 
@@ -25,6 +28,13 @@ enum Command {
     Info(cmd_info::Args),
     /// Convert a mesh to GLB, glTF, OBJ or PLY (optionally normalised into the unit cube).
     Convert(cmd_convert::Args),
+    /// Draw training samples (uniform + near-surface) with winding number, occupancy and
+    /// signed distance.
+    Sample(cmd_sample::Args),
+    /// Winding number, occupancy, signed distance and closest point of given points.
+    Query(cmd_query::Args),
+    /// Exact 3D Delaunay tetrahedralization of a point set (.npy in, .npy of tets out).
+    Delaunay(cmd_delaunay::Args),
 }
 
 fn main() {
@@ -39,6 +49,9 @@ fn main() {
     let result: Result<(), CliError> = match cli.command {
         Command::Info(args) => cmd_info::run(args),
         Command::Convert(args) => cmd_convert::run(args),
+        Command::Sample(args) => cmd_sample::run(args),
+        Command::Query(args) => cmd_query::run(args),
+        Command::Delaunay(args) => cmd_delaunay::run(args),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");

@@ -12,7 +12,8 @@ fn root() -> PathBuf {
 }
 
 fn shared_meshes() -> Vec<PathBuf> {
-    let dir = std::env::var_os("VF_SHARED_MESHES").map(PathBuf::from).unwrap_or_else(|| root().join("../shared/meshes"));
+    let dir =
+        std::env::var_os("VF_SHARED_MESHES").map(PathBuf::from).unwrap_or_else(|| root().join("../shared/meshes"));
     let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("{}: the shared test meshes must sit beside the repository ({e})", dir.display()))
         .map(|e| e.unwrap().path())
@@ -71,7 +72,10 @@ fn known_topology_of_shared_meshes() {
     assert!(bunny["num_duplicate_faces"].as_u64().unwrap() > 0);
     let teapot = report("mikedh__teapot.stl");
     assert_eq!(teapot["num_boundary_loops"], 6);
-    assert_eq!(report("mikedh__featuretype.STL")["genus"], 9);
+    // Genus 9 per the README after trimesh's tolerance merge; welded exactly, 16 hairline
+    // cracks (vertices a few ulps apart) stay open, as trimesh with process=False agrees.
+    let feature = report("mikedh__featuretype.STL");
+    assert_eq!((feature["is_closed"].as_bool(), feature["num_boundary_loops"].as_u64()), (Some(false), Some(16)));
     assert_eq!(report("alecjacobson__spot.obj")["genus"], 0);
     assert_eq!(report("mikedh__multibody.stl")["num_components"], 2);
     assert_eq!(report("mikedh__soup.stl")["num_components"], 100);

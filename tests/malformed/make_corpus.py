@@ -65,10 +65,13 @@ gl = {
 put("index_out_of_range.gltf", json.dumps(gl), "accessor 1")
 pt = dict(gl)
 pt["meshes"] = [{"primitives": [{"attributes": {"POSITION": 0}, "mode": 0}]}]
-put("points_only.gltf", json.dumps(pt), "POINTS")
+put("points_only.gltf", json.dumps(pt), "mesh 0 primitive 0: Points")
 ov = dict(gl)
 ov["accessors"] = [dict(gl["accessors"][0], count=300)] + gl["accessors"][1:]
 put("accessor_overflow.gltf", json.dumps(ov), "accessor 0")
+dg = dict(gl)
+dg["meshes"] = [{"primitives": [{"attributes": {"POSITION": 7}}]}]
+put("dangling_accessor.gltf", json.dumps(dg), "mesh 0")  # regression: panicked inside gltf-json 1.4
 put("unknown_format.xyz", "1 2 3\n", "no supported mesh format")
 
 with open("EXPECTED.tsv", "w") as f:

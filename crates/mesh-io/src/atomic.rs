@@ -13,10 +13,7 @@ use crate::error::MeshError;
 /// # Errors
 /// [`crate::ErrorKind::Write`] naming `path` if the temporary file cannot be created,
 /// written, synced or renamed.
-pub fn atomic_write(
-    path: &Path,
-    fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-) -> Result<(), MeshError> {
+pub fn atomic_write(path: &Path, fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<(), MeshError> {
     let tmp = prepare(path, fill)?;
     tmp.persist(path).map_err(|e| MeshError::write(path, e.error))?;
     Ok(())
@@ -43,9 +40,7 @@ pub(crate) fn prepare(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    let mut tmp = builder
-        .tempfile_in(dir)
-        .map_err(|e| MeshError::write(path, e))?;
+    let mut tmp = builder.tempfile_in(dir).map_err(|e| MeshError::write(path, e))?;
     {
         let mut w = BufWriter::new(tmp.as_file_mut());
         fill(&mut w).map_err(|e| MeshError::write(path, e))?;

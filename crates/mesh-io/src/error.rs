@@ -109,9 +109,7 @@ fn default_hint(kind: ErrorKind) -> &'static str {
             "Supported inputs are .obj, .stl, .ply, .off, .gltf and .glb; convert the file to one of them."
         }
         ErrorKind::Syntax => "The file is malformed; re-export it from the program that made it.",
-        ErrorKind::Truncated => {
-            "The file is cut short (an interrupted copy or download?); re-export or copy it again."
-        }
+        ErrorKind::Truncated => "The file is cut short (an interrupted copy or download?); re-export or copy it again.",
         ErrorKind::NonFinite => {
             "Every coordinate must be a finite number; remove or repair the vertex in the program that made the file."
         }

@@ -59,9 +59,28 @@ impl TriMesh {
         ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
     }
 
+    /// The triangles as corner positions (bit patterns), each rotated to start at its
+    /// smallest corner (orientation kept) and the list sorted: equal for two meshes with the
+    /// same oriented triangles whatever their vertex numbering.
+    pub fn canonical_triangles(&self) -> Vec<[[u64; 3]; 3]> {
+        let mut v: Vec<[[u64; 3]; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let c = t.map(|i| self.positions[i as usize].map(f64::to_bits));
+                let k = (0..3).min_by_key(|&k| c[k]).unwrap_or(0);
+                [c[k], c[(k + 1) % 3], c[(k + 2) % 3]]
+            })
+            .collect();
+        v.sort_unstable();
+        v
+    }
+
     /// Check what readers guarantee: finite coordinates, indices in range (the mesh may be
     /// empty). `what` names the mesh in the error.
     pub fn validate(&self, what: &std::path::Path) -> Result<(), MeshError> {
-        read::finish(self.clone(), what).map(|_| ()).or_else(|e| if e.kind == ErrorKind::Empty { Ok(()) } else { Err(e) })
+        read::finish(self.clone(), what)
+            .map(|_| ())
+            .or_else(|e| if e.kind == ErrorKind::Empty { Ok(()) } else { Err(e) })
     }
 }

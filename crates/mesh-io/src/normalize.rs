@@ -49,12 +49,18 @@ impl UnitCubeTransform {
 
     /// A copy of `mesh` mapped into the unit cube.
     pub fn mesh_to_unit(&self, mesh: &TriMesh) -> TriMesh {
-        TriMesh { positions: mesh.positions.iter().map(|&p| self.to_unit(p)).collect(), triangles: mesh.triangles.clone() }
+        TriMesh {
+            positions: mesh.positions.iter().map(|&p| self.to_unit(p)).collect(),
+            triangles: mesh.triangles.clone(),
+        }
     }
 
     /// A copy of `mesh` mapped from the unit cube back to the input frame.
     pub fn mesh_from_unit(&self, mesh: &TriMesh) -> TriMesh {
-        TriMesh { positions: mesh.positions.iter().map(|&u| self.from_unit(u)).collect(), triangles: mesh.triangles.clone() }
+        TriMesh {
+            positions: mesh.positions.iter().map(|&u| self.from_unit(u)).collect(),
+            triangles: mesh.triangles.clone(),
+        }
     }
 
     /// 4×4 row-major matrix of [`Self::to_unit`] on homogeneous column vectors.

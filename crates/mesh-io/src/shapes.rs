@@ -11,18 +11,43 @@ use crate::TriMesh;
 pub fn icosphere(subdivisions: u32) -> TriMesh {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let mut positions: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0],
-        [0.0, -1.0, t], [0.0, 1.0, t], [0.0, -1.0, -t], [0.0, 1.0, -t],
-        [t, 0.0, -1.0], [t, 0.0, 1.0], [-t, 0.0, -1.0], [-t, 0.0, 1.0],
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
     ]
     .iter()
     .map(|p| normalized(*p))
     .collect();
     let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11],
-        [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8],
-        [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
-        [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
     ];
     for _ in 0..subdivisions {
         let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
@@ -109,9 +134,5 @@ pub fn box_with_hole_volume(half_width: f64, wall: f64) -> f64 {
 
 /// The generated meshes shipped in `assets/`, by file stem.
 pub fn asset_shapes() -> Vec<(&'static str, TriMesh)> {
-    vec![
-        ("icosphere", icosphere(4)),
-        ("torus", torus(1.0, 0.35, 64, 32)),
-        ("box_with_hole", box_with_hole(1.0, 0.3)),
-    ]
+    vec![("icosphere", icosphere(4)), ("torus", torus(1.0, 0.35, 64, 32)), ("box_with_hole", box_with_hole(1.0, 0.3))]
 }

@@ -49,10 +49,12 @@ pub struct TopologyReport {
     /// Every edge with exactly two faces is traversed in opposite directions by them
     /// (trimesh's `is_winding_consistent`).
     pub is_orientation_consistent: bool,
-    /// Σ over faces of det(a, b, c) / 6, in the file's units cubed; positive for a closed
-    /// mesh oriented counter-clockwise seen from outside.
+    /// Σ over faces of det(a, b, c) / 6 (the origin as reference point, as trimesh), in the
+    /// file's units cubed; positive for a closed mesh oriented counter-clockwise seen from
+    /// outside. For an open mesh it depends on where the origin is.
     pub signed_volume: f64,
     pub surface_area: f64,
+    /// Bounding box of the referenced vertices.
     pub bbox_min: [f64; 3],
     pub bbox_max: [f64; 3],
 }
@@ -188,9 +190,8 @@ impl TopologyReport {
             }
             i = j;
         }
-        let num_boundary_loops = (0..nv as u32)
-            .filter(|&v| boundary_vertex[v as usize] && boundary_dsu.find(v) == v)
-            .count();
+        let num_boundary_loops =
+            (0..nv as u32).filter(|&v| boundary_vertex[v as usize] && boundary_dsu.find(v) == v).count();
 
         // Fans per vertex: distinct corner roots among the vertex's corners.
         let mut fan_root = vec![u32::MAX; nv];
@@ -223,33 +224,43 @@ impl TopologyReport {
         let is_manifold = num_non_manifold_edges == 0 && num_non_manifold_vertices == 0;
         let is_orientation_consistent = nf > 0 && orientation_ok;
         let twice_genus = 2 * num_components as i64 - euler_characteristic;
-        let genus = (is_closed && is_manifold && is_orientation_consistent && twice_genus % 2 == 0)
-            .then_some(twice_genus / 2);
+        let genus =
+            (is_closed && is_manifold && is_orientation_consistent && twice_genus % 2 == 0).then_some(twice_genus / 2);
 
-        let (bbox_min, bbox_max) = mesh.bounding_box();
+        let mut bbox_min = [f64::INFINITY; 3];
+        let mut bbox_max = [f64::NEG_INFINITY; 3];
+        for (q, _) in p.iter().zip(&referenced).filter(|(_, &r)| r) {
+            for k in 0..3 {
+                bbox_min[k] = bbox_min[k].min(q[k]);
+                bbox_max[k] = bbox_max[k].max(q[k]);
+            }
+        }
         // Volume and area relative to the box centre, which keeps the determinants small.
         let c = [0, 1, 2].map(|k| 0.5 * (bbox_min[k] + bbox_max[k]));
         let mut volume = 0.0;
         let mut area = 0.0;
+        let mut normal_sum = [0.0; 3];
         for t in &mesh.triangles {
             let [a, b, d] = t.map(|i| {
                 let q = p[i as usize];
                 [q[0] - c[0], q[1] - c[1], q[2] - c[2]]
             });
-            let cross = [
-                b[1] * d[2] - b[2] * d[1],
-                b[2] * d[0] - b[0] * d[2],
-                b[0] * d[1] - b[1] * d[0],
-            ];
+            let cross = [b[1] * d[2] - b[2] * d[1], b[2] * d[0] - b[0] * d[2], b[0] * d[1] - b[1] * d[0]];
             volume += a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2];
             let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
             let e2 = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-            let n = [
-                e1[1] * e2[2] - e1[2] * e2[1],
-                e1[2] * e2[0] - e1[0] * e2[2],
-                e1[0] * e2[1] - e1[1] * e2[0],
-            ];
+            let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
             area += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            for k in 0..3 {
+                normal_sum[k] += n[k];
+            }
+        }
+        // Back to the origin as the reference point (trimesh's convention), exactly:
+        // det(a, b, d) = det(a', b', d') + c · ((b' − a') × (d' − a')) for a' = a − c.
+        // Σ N is zero on a closed mesh, so only open meshes, whose "volume" depends on the
+        // reference point anyway, are affected.
+        if !mesh.triangles.is_empty() {
+            volume += c[0] * normal_sum[0] + c[1] * normal_sum[1] + c[2] * normal_sum[2];
         }
 
         TopologyReport {

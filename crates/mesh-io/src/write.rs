@@ -90,7 +90,12 @@ fn push_bytes(bin: &mut Vec<u8>, data: impl Iterator<Item = [u8; 4]>) -> (usize,
     (start, bin.len() - start)
 }
 
-fn view(root: &mut json::Root, buffer: json::Index<json::Buffer>, span: (usize, usize), target: json::buffer::Target) -> json::Index<json::buffer::View> {
+fn view(
+    root: &mut json::Root,
+    buffer: json::Index<json::Buffer>,
+    span: (usize, usize),
+    target: json::buffer::Target,
+) -> json::Index<json::buffer::View> {
     root.push(json::buffer::View {
         buffer,
         byte_length: USize64::from(span.1),
@@ -132,14 +137,23 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
     use json::accessor::{ComponentType as C, Type as T};
     use json::buffer::Target;
     let mut root = json::Root {
-        asset: json::Asset { generator: Some(format!("voronoi-fit {}", env!("CARGO_PKG_VERSION"))), ..Default::default() },
+        asset: json::Asset {
+            generator: Some(format!("voronoi-fit {}", env!("CARGO_PKG_VERSION"))),
+            ..Default::default()
+        },
         ..Default::default()
     };
     let mut bin = Vec::new();
     let total: usize = meshes.iter().filter(|m| !m.mesh.triangles.is_empty()).map(|m| m.mesh.positions.len()).sum();
     // The buffer entry is created only if some mesh has data: glTF forbids empty buffers.
     let buffer = (total > 0).then(|| {
-        root.push(json::Buffer { byte_length: USize64(0), extensions: None, extras: Default::default(), name: None, uri: bin_uri })
+        root.push(json::Buffer {
+            byte_length: USize64(0),
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            uri: bin_uri,
+        })
     });
     let mut nodes = Vec::new();
     for m in meshes {
@@ -165,10 +179,7 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
             attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
             attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
             if let Some(colors) = m.colors {
-                let span = push_bytes(
-                    &mut bin,
-                    colors.iter().flat_map(|c| c.map(|x| x.clamp(0.0, 1.0).to_le_bytes())),
-                );
+                let span = push_bytes(&mut bin, colors.iter().flat_map(|c| c.map(|x| x.clamp(0.0, 1.0).to_le_bytes())));
                 let v = view(&mut root, buffer, span, Target::ArrayBuffer);
                 let colors = accessor(&mut root, v, colors.len(), C::F32, T::Vec3, None);
                 attributes.insert(Valid(json::mesh::Semantic::Colors(0)), colors);
@@ -198,7 +209,8 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
     if let Some(b) = buffer {
         root.buffers[b.value()].byte_length = USize64::from(bin.len());
     }
-    let scene = root.push(json::Scene { extensions: Default::default(), extras: Default::default(), name: None, nodes });
+    let scene =
+        root.push(json::Scene { extensions: Default::default(), extras: Default::default(), name: None, nodes });
     root.scene = Some(scene);
     (root, bin)
 }
@@ -248,7 +260,13 @@ pub fn write_gltf(path: &Path, meshes: &[SceneMesh], layout: GltfLayout) -> Resu
 /// `f` lines.
 pub fn write_obj(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
     atomic_write(path, |w| {
-        writeln!(w, "# voronoi-fit {}: {} vertices, {} triangles", env!("CARGO_PKG_VERSION"), mesh.positions.len(), mesh.triangles.len())?;
+        writeln!(
+            w,
+            "# voronoi-fit {}: {} vertices, {} triangles",
+            env!("CARGO_PKG_VERSION"),
+            mesh.positions.len(),
+            mesh.triangles.len()
+        )?;
         for p in &mesh.positions {
             writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
         }

@@ -2,7 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use mesh_io::{read_mesh, shapes, write_gltf, write_mesh, ErrorKind, GltfLayout, Location, SceneMesh, TopologyReport, TriMesh};
+use mesh_io::{
+    read_mesh, shapes, write_gltf, write_mesh, ErrorKind, GltfLayout, Location, SceneMesh, TopologyReport, TriMesh,
+};
 
 fn tmp() -> tempfile::TempDir {
     tempfile::tempdir().unwrap()
@@ -14,24 +16,15 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     p
 }
 
-/// Same triangles as sets of corner positions, independent of vertex order.
 fn triangle_set(m: &TriMesh) -> Vec<[[u64; 3]; 3]> {
-    let mut v: Vec<[[u64; 3]; 3]> = m
-        .triangles
-        .iter()
-        .map(|t| {
-            // Rotate so the smallest corner comes first; keeps orientation.
-            let c = t.map(|i| m.positions[i as usize].map(f64::to_bits));
-            let k = (0..3).min_by_key(|&k| c[k]).unwrap();
-            [c[k], c[(k + 1) % 3], c[(k + 2) % 3]]
-        })
-        .collect();
-    v.sort();
-    v
+    m.canonical_triangles()
 }
 
 fn f32_rounded(m: &TriMesh) -> TriMesh {
-    TriMesh { positions: m.positions.iter().map(|p| p.map(|c| c as f32 as f64)).collect(), triangles: m.triangles.clone() }
+    TriMesh {
+        positions: m.positions.iter().map(|p| p.map(|c| c as f32 as f64)).collect(),
+        triangles: m.triangles.clone(),
+    }
 }
 
 #[test]
@@ -63,7 +56,8 @@ fn every_writer_round_trips_an_icosphere() {
         assert_eq!(back.positions.len(), m.positions.len(), "{ext}");
     }
     // Only the outputs, no temporary files, remain.
-    let mut names: Vec<String> = std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    let mut names: Vec<String> =
+        std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
     names.sort();
     assert_eq!(names, ["s.bin", "s.glb", "s.gltf", "s.obj", "s.ply"]);
 }
@@ -167,7 +161,11 @@ fn ply_ascii_little_and_big_endian_agree() {
 #[test]
 fn off_with_comments_polygons_and_colours() {
     let d = tmp();
-    let p = write(d.path(), "a.off", b"OFF\n# a square and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n");
+    let p = write(
+        d.path(),
+        "a.off",
+        b"OFF\n# a square and a triangle\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n4 0 1 2 3 255 0 0\n3 0 1 4\n",
+    );
     assert_eq!(read_mesh(&p).unwrap().triangles, vec![[0, 1, 2], [0, 2, 3], [0, 1, 4]]);
     let p = write(d.path(), "b.off", b"OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     assert_eq!(read_mesh(&p).unwrap().triangles.len(), 1);
@@ -213,7 +211,8 @@ fn gltf_node_transforms_and_strips() {
     for i in [0u16, 1, 2, 3] {
         bin.extend_from_slice(&i.to_le_bytes());
     }
-    let uri = format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
+    let uri =
+        format!("data:application/octet-stream;base64,{}", base64::engine::general_purpose::STANDARD.encode(&bin));
     let json = format!(
         r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
         "nodes":[{{"translation":[10,0,0],"children":[1]}},{{"scale":[-1,1,1],"mesh":0}}],
@@ -269,4 +268,17 @@ fn a_failed_write_leaves_nothing_behind() {
     assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 1, "no temporary file remains");
     let missing_dir = d.path().join("no/such/dir/out.glb");
     assert_eq!(write_mesh(&missing_dir, &shapes::icosphere(0)).unwrap_err().kind, ErrorKind::Write);
+}
+
+/// Regression: a GLB header declaring a total length below 12 bytes made gltf 1.4 panic
+/// on an integer underflow.
+#[test]
+fn glb_with_tiny_declared_length_is_an_error_not_a_panic() {
+    let d = tmp();
+    let mut b = b"glTF".to_vec();
+    b.extend_from_slice(&2u32.to_le_bytes());
+    b.extend_from_slice(&4u32.to_le_bytes());
+    b.extend_from_slice(&[0u8; 20]);
+    let e = read_mesh(&write(d.path(), "tiny.glb", &b)).unwrap_err();
+    assert_eq!((e.kind, e.location), (ErrorKind::Syntax, Location::Byte(8)));
 }

@@ -19,6 +19,21 @@ use crate::TriMesh;
 type Mat4 = [[f64; 4]; 4]; // column-major, as glTF stores it
 
 pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
+    // gltf 1.4 subtracts the header size from the declared length without checking it
+    // (an overflow panic on a GLB declaring fewer than 12 bytes): check it here first.
+    // Regression: found by tests/no_panic.rs.
+    if bytes.starts_with(b"glTF") && bytes.len() >= 12 {
+        let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+        if declared < 12 {
+            return Err(MeshError::new(
+                ErrorKind::Syntax,
+                path,
+                Location::Byte(8),
+                format!("not a valid glTF 2.0 file: the GLB header declares a total length of {declared} bytes, less than the header itself"),
+            ));
+        }
+    }
+    check_attribute_indices(bytes, path)?;
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
         let kind = match e {
             gltf::Error::Binary(_) if bytes.starts_with(b"glTF") => ErrorKind::Truncated,
@@ -29,9 +44,8 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
     let buffers = load_buffers(&gltf, path)?;
     let doc = &gltf.document;
     let scene = doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| {
-        MeshError::new(ErrorKind::Empty, path, Location::File, "the file defines no scene").hint(
-            "Export the glTF with a scene that contains the mesh nodes.",
-        )
+        MeshError::new(ErrorKind::Empty, path, Location::File, "the file defines no scene")
+            .hint("Export the glTF with a scene that contains the mesh nodes.")
     })?;
 
     let mut mesh = TriMesh::default();
@@ -71,6 +85,47 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
     Ok(mesh)
 }
 
+/// gltf-json 1.4's primitive validation indexes `accessors` with the POSITION attribute's
+/// index before checking its range (a panic on a file with a dangling index). Deserialise
+/// the JSON once without validation and check every attribute index first.
+/// Regression: found by tests/no_panic.rs.
+fn check_attribute_indices(bytes: &[u8], path: &Path) -> Result<()> {
+    let json: &[u8] = if bytes.starts_with(b"glTF") {
+        match gltf::binary::Glb::from_slice(bytes) {
+            Ok(glb) => return check_json(&glb.json, path),
+            Err(_) => return Ok(()), // Gltf::from_slice reports it properly
+        }
+    } else {
+        bytes
+    };
+    check_json(json, path)
+}
+
+fn check_json(json: &[u8], path: &Path) -> Result<()> {
+    let Ok(root) = serde_json::from_slice::<gltf_json::Root>(json) else {
+        return Ok(()); // Gltf::from_slice reports the syntax error
+    };
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (k, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    return Err(MeshError::new(
+                        ErrorKind::Syntax,
+                        path,
+                        Location::Element { kind: "mesh", index: m },
+                        format!(
+                            "not a valid glTF 2.0 file: primitive {k} of mesh {m} uses accessor {} for {semantic:?}, but the file has {} accessors",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 const IDENTITY: Mat4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
 
 fn mul(a: &Mat4, b: &Mat4) -> Mat4 {
@@ -102,7 +157,12 @@ fn load_buffers(gltf: &gltf::Gltf, path: &Path) -> Result<Vec<Vec<u8>>> {
                         MeshError::new(ErrorKind::Unsupported, path, loc.clone(), "a data URI that is not base64")
                     })?;
                     base64::engine::general_purpose::STANDARD.decode(b64).map_err(|e| {
-                        MeshError::new(ErrorKind::Syntax, path, loc.clone(), format!("the base64 data URI is corrupt ({e})"))
+                        MeshError::new(
+                            ErrorKind::Syntax,
+                            path,
+                            loc.clone(),
+                            format!("the base64 data URI is corrupt ({e})"),
+                        )
                     })?
                 } else {
                     let file = path.parent().unwrap_or(Path::new(".")).join(percent_decode(uri));
@@ -171,12 +231,17 @@ fn accessor_data<'a>(acc: &gltf::Accessor, buffers: &'a [Vec<u8>], path: &Path) 
             .hint("Re-export the glTF without sparse accessors."));
     }
     let view = acc.view().ok_or_else(|| {
-        MeshError::new(ErrorKind::Unsupported, path, loc.clone(), "the accessor has no buffer view (Draco or another compression extension?)")
-            .hint("Re-export the glTF without mesh compression.")
+        MeshError::new(
+            ErrorKind::Unsupported,
+            path,
+            loc.clone(),
+            "the accessor has no buffer view (Draco or another compression extension?)",
+        )
+        .hint("Re-export the glTF without mesh compression.")
     })?;
-    let buffer = buffers.get(view.buffer().index()).ok_or_else(|| {
-        MeshError::new(ErrorKind::Syntax, path, loc.clone(), "the accessor's buffer does not exist")
-    })?;
+    let buffer = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| MeshError::new(ErrorKind::Syntax, path, loc.clone(), "the accessor's buffer does not exist"))?;
     let elem = acc.size();
     let stride = view.stride().unwrap_or(elem);
     let start = view.offset().checked_add(acc.offset());
@@ -223,7 +288,12 @@ fn read_primitive(
     }
     let loc = Location::Element { kind: "mesh", index: mesh_index };
     let pos = prim.get(&gltf::Semantic::Positions).ok_or_else(|| {
-        MeshError::new(ErrorKind::Syntax, path, loc.clone(), format!("primitive {} has no POSITION attribute", prim.index()))
+        MeshError::new(
+            ErrorKind::Syntax,
+            path,
+            loc.clone(),
+            format!("primitive {} has no POSITION attribute", prim.index()),
+        )
     })?;
     if pos.data_type() != DataType::F32 || pos.dimensions() != Dimensions::Vec3 {
         return Err(MeshError::new(
@@ -290,7 +360,11 @@ fn read_primitive(
                         ErrorKind::IndexOutOfRange,
                         path,
                         Location::Element { kind: "accessor", index: acc.index() },
-                        format!("index {i} of accessor {} is {v} but the primitive has {} vertices", acc.index(), pdata.count),
+                        format!(
+                            "index {i} of accessor {} is {v} but the primitive has {} vertices",
+                            acc.index(),
+                            pdata.count
+                        ),
                     ));
                 }
                 out.push(v);

@@ -16,7 +16,6 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = std::io::BufReader::new(bytes);
     // Materials are irrelevant to geometry: a missing .mtl must not fail the load.
@@ -52,22 +51,25 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
         return Err(locate(bytes, path, "a vertex coordinate is NaN or infinite"));
     }
     if mesh.triangles.is_empty() {
+        // tobj drops faces with fewer than three corners silently: name such a line if
+        // there is one, since it is the likely reason for the empty result.
+        let located = locate(bytes, path, "no face");
+        if located.location != Location::File {
+            return Err(located);
+        }
         let n = text_vertex_count(bytes);
         return Err(MeshError::new(
             ErrorKind::Empty,
             path,
             Location::File,
-            format!("the file holds no face (it has {n} `v` lines); is it really an OBJ mesh?"),
+            format!("the file holds no face (it has {n} `v` lines), so it is not an OBJ mesh"),
         ));
     }
     Ok(mesh)
 }
 
 fn text_vertex_count(bytes: &[u8]) -> usize {
-    bytes
-        .split(|&b| b == b'\n')
-        .filter(|l| l.starts_with(b"v ") || l.starts_with(b"v\t"))
-        .count()
+    bytes.split(|&b| b == b'\n').filter(|l| l.starts_with(b"v ") || l.starts_with(b"v\t")).count()
 }
 
 /// Find the first line that explains a failure reported by tobj (or by the checks after

@@ -38,7 +38,12 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
         None => match body.next() {
             Some((n, l)) => (n, l.split_whitespace().collect()),
             None => {
-                return Err(MeshError::new(ErrorKind::Truncated, path, Location::Line(hn), "the vertex and face counts are missing"))
+                return Err(MeshError::new(
+                    ErrorKind::Truncated,
+                    path,
+                    Location::Line(hn),
+                    "the vertex and face counts are missing",
+                ))
             }
         },
     };

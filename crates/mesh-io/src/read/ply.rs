@@ -104,7 +104,9 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
             elements[f]
                 .props
                 .iter()
-                .position(|p| matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index"))
+                .position(
+                    |p| matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index"),
+                )
                 .ok_or_else(|| {
                     MeshError::new(
                         ErrorKind::Syntax,
@@ -128,11 +130,9 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
     let mut mesh = TriMesh::default();
     let mut reader: Box<dyn Values + '_> = match encoding {
         Encoding::Ascii => Box::new(AsciiValues::new(bytes, body_start, header_lines)),
-        Encoding::Little | Encoding::Big => Box::new(BinaryValues {
-            bytes,
-            pos: body_start,
-            big: encoding == Encoding::Big,
-        }),
+        Encoding::Little | Encoding::Big => {
+            Box::new(BinaryValues { bytes, pos: body_start, big: encoding == Encoding::Big })
+        }
     };
     let mut poly: Vec<u32> = Vec::new();
     for (ei, el) in elements.iter().enumerate() {
@@ -282,9 +282,8 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
             _ => return Err(err(format!("unexpected header line {line:?}"))),
         }
     }
-    let encoding = encoding.ok_or_else(|| {
-        MeshError::new(ErrorKind::Syntax, path, Location::File, "the header has no `format` line")
-    })?;
+    let encoding = encoding
+        .ok_or_else(|| MeshError::new(ErrorKind::Syntax, path, Location::File, "the header has no `format` line"))?;
     Ok((encoding, elements, pos, line_no))
 }
 
@@ -316,10 +315,7 @@ impl Values for BinaryValues<'_> {
                 ErrorKind::Truncated,
                 path,
                 Location::Element { kind: element_kind(element), index },
-                format!(
-                    "the file ends at byte {} inside {element} {index}: it is truncated",
-                    self.bytes.len()
-                ),
+                format!("the file ends at byte {} inside {element} {index}: it is truncated", self.bytes.len()),
             ));
         };
         self.pos += n;
@@ -358,8 +354,10 @@ fn element_kind(element: &str) -> &'static str {
 }
 
 /// ASCII bodies: one element instance per line, as every PLY writer does.
+type NumberedLines<'a> = std::iter::Enumerate<std::slice::Split<'a, u8, fn(&u8) -> bool>>;
+
 struct AsciiValues<'a> {
-    lines: std::iter::Enumerate<std::slice::Split<'a, u8, fn(&u8) -> bool>>,
+    lines: NumberedLines<'a>,
     first_line: usize,
     current: Vec<&'a str>,
     next_tok: usize,
@@ -406,14 +404,14 @@ impl Values for AsciiValues<'_> {
             return Err(self.error(element, index, path, &format!("{element} {index} has too few values on its line")));
         };
         self.next_tok += 1;
-        let v: f64 = tok
-            .parse()
-            .map_err(|_| self.error(element, index, path, &format!("{tok:?} is not a number")))?;
+        let v: f64 = tok.parse().map_err(|_| self.error(element, index, path, &format!("{tok:?} is not a number")))?;
         let integral = !matches!(ty, Scalar::F32 | Scalar::F64);
         if integral && v.is_finite() && v.fract() != 0.0 {
             return Err(self.error(element, index, path, &format!("{tok:?} should be a whole number")));
         }
-        Ok(v)
+        // A `float` property holds a float32, whatever digits the text has: round as the
+        // binary encodings (and numpy, trimesh) do.
+        Ok(if ty == Scalar::F32 { v as f32 as f64 } else { v })
     }
     fn end_element(&mut self, element: &str, index: usize, path: &Path) -> Result<()> {
         if self.next_tok != self.current.len() {

@@ -49,10 +49,7 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
 
 fn read_binary(bytes: &[u8], count: usize, path: &Path) -> Result<TriMesh> {
     super::check_vertex_count(count.saturating_mul(3), path)?;
-    let mut mesh = TriMesh {
-        positions: Vec::with_capacity(count * 3),
-        triangles: Vec::with_capacity(count),
-    };
+    let mut mesh = TriMesh { positions: Vec::with_capacity(count * 3), triangles: Vec::with_capacity(count) };
     for (t, rec) in bytes[84..].chunks_exact(50).enumerate() {
         let f = |k: usize| f32::from_le_bytes([rec[k], rec[k + 1], rec[k + 2], rec[k + 3]]) as f64;
         let base = mesh.positions.len() as u32;

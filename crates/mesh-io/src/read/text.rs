@@ -27,7 +27,12 @@ pub(crate) fn lines<'a>(bytes: &'a [u8], path: &Path) -> Result<Vec<(usize, &'a 
 /// Parse one coordinate token, naming the line and what was expected on failure.
 pub(crate) fn parse_f64(tok: Option<&str>, path: &Path, line: usize, what: &str) -> Result<f64> {
     let tok = tok.ok_or_else(|| {
-        MeshError::new(ErrorKind::Syntax, path, Location::Line(line), format!("expected {what}, found the end of the line"))
+        MeshError::new(
+            ErrorKind::Syntax,
+            path,
+            Location::Line(line),
+            format!("expected {what}, found the end of the line"),
+        )
     })?;
     let v: f64 = tok.parse().map_err(|_| {
         MeshError::new(ErrorKind::Syntax, path, Location::Line(line), format!("expected {what}, found {tok:?}"))
@@ -46,7 +51,12 @@ pub(crate) fn parse_f64(tok: Option<&str>, path: &Path, line: usize, what: &str)
 /// Parse a non-negative integer token (counts, indices).
 pub(crate) fn parse_usize(tok: Option<&str>, path: &Path, line: usize, what: &str) -> Result<usize> {
     let tok = tok.ok_or_else(|| {
-        MeshError::new(ErrorKind::Syntax, path, Location::Line(line), format!("expected {what}, found the end of the line"))
+        MeshError::new(
+            ErrorKind::Syntax,
+            path,
+            Location::Line(line),
+            format!("expected {what}, found the end of the line"),
+        )
     })?;
     tok.parse().map_err(|_| {
         MeshError::new(
@@ -59,11 +69,7 @@ pub(crate) fn parse_usize(tok: Option<&str>, path: &Path, line: usize, what: &st
 }
 
 /// Three coordinates from a token iterator.
-pub(crate) fn parse_point<'a>(
-    toks: &mut impl Iterator<Item = &'a str>,
-    path: &Path,
-    line: usize,
-) -> Result<[f64; 3]> {
+pub(crate) fn parse_point<'a>(toks: &mut impl Iterator<Item = &'a str>, path: &Path, line: usize) -> Result<[f64; 3]> {
     Ok([
         parse_f64(toks.next(), path, line, "an x coordinate")?,
         parse_f64(toks.next(), path, line, "a y coordinate")?,
