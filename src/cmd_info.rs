@@ -24,32 +24,32 @@ pub fn run(args: Args) -> Result<(), CliError> {
             report: &'a mesh_io::TopologyReport,
         }
         let out = Out { file: args.mesh.display().to_string(), report: &r };
-        println!("{}", serde_json::to_string_pretty(&out).map_err(anyhow::Error::from)?);
+        crate::output::out!("{}", serde_json::to_string_pretty(&out).map_err(anyhow::Error::from)?);
         return Ok(());
     }
     let yes = |b: bool| if b { "yes" } else { "no" };
-    println!("{}", args.mesh.display());
-    println!("  vertices            {} ({} referenced)", r.num_vertices, r.num_referenced_vertices);
-    println!(
+    crate::output::out!("{}", args.mesh.display());
+    crate::output::out!("  vertices            {} ({} referenced)", r.num_vertices, r.num_referenced_vertices);
+    crate::output::out!(
         "  faces               {} ({} degenerate, {} duplicate)",
         r.num_faces, r.num_degenerate_faces, r.num_duplicate_faces
     );
-    println!(
+    crate::output::out!(
         "  edges               {} ({} boundary in {} loops, {} non-manifold)",
         r.num_edges, r.num_boundary_edges, r.num_boundary_loops, r.num_non_manifold_edges
     );
-    println!("  non-manifold verts  {}", r.num_non_manifold_vertices);
-    println!("  components          {}", r.num_components);
-    println!("  Euler characteristic {}", r.euler_characteristic);
+    crate::output::out!("  non-manifold verts  {}", r.num_non_manifold_vertices);
+    crate::output::out!("  components          {}", r.num_components);
+    crate::output::out!("  Euler characteristic {}", r.euler_characteristic);
     match r.genus {
         Some(g) => println!("  genus               {g}"),
         None => println!("  genus               n/a (not closed, manifold and oriented)"),
     }
-    println!("  closed              {}", yes(r.is_closed));
-    println!("  manifold            {}", yes(r.is_manifold));
-    println!("  consistently oriented {}", yes(r.is_orientation_consistent));
-    println!("  signed volume       {:.9e}", r.signed_volume);
-    println!("  surface area        {:.9e}", r.surface_area);
-    println!("  bounding box        {:?} .. {:?}", r.bbox_min, r.bbox_max);
+    crate::output::out!("  closed              {}", yes(r.is_closed));
+    crate::output::out!("  manifold            {}", yes(r.is_manifold));
+    crate::output::out!("  consistently oriented {}", yes(r.is_orientation_consistent));
+    crate::output::out!("  signed volume       {:.9e}", r.signed_volume);
+    crate::output::out!("  surface area        {:.9e}", r.surface_area);
+    crate::output::out!("  bounding box        {:?} .. {:?}", r.bbox_min, r.bbox_max);
     Ok(())
 }

@@ -6,10 +6,12 @@
 mod arrays;
 mod cli_error;
 mod cmd_convert;
+mod cmd_crust;
 mod cmd_delaunay;
 mod cmd_info;
 mod cmd_query;
 mod cmd_sample;
+mod output;
 
 use clap::{Parser, Subcommand};
 
@@ -35,6 +37,8 @@ enum Command {
     Query(cmd_query::Args),
     /// Exact 3D Delaunay tetrahedralization of a point set (.npy in, .npy of tets out).
     Delaunay(cmd_delaunay::Args),
+    /// Watertight crust (and optionally the convex inside cells) of a sites file.
+    Crust(cmd_crust::Args),
 }
 
 fn main() {
@@ -52,6 +56,7 @@ fn main() {
         Command::Sample(args) => cmd_sample::run(args),
         Command::Query(args) => cmd_query::run(args),
         Command::Delaunay(args) => cmd_delaunay::run(args),
+        Command::Crust(args) => cmd_crust::run(args),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");

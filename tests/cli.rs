@@ -108,3 +108,21 @@ fn write_failure_exits_1() {
     let o = bin().arg("convert").arg(&input).args(["-o", "/no/such/dir/x.glb"]).output().unwrap();
     assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// Regression: `voronoi-fit info MESH | head -1` panicked on the broken pipe.
+#[test]
+fn a_closed_stdout_pipe_is_not_a_panic() {
+    use std::process::Stdio;
+    let mut child = bin()
+        .arg("info")
+        .arg(root().join("assets/bunny.obj"))
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take()); // the reader goes away before anything is written
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+}

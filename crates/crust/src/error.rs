@@ -1,0 +1,35 @@
+//! The crate's error type.
+
+/// Why a crust could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum CrustError {
+    /// `sites` and `labels` differ in length.
+    #[error("{num_sites} sites but {num_labels} labels; give one label per site")]
+    LengthMismatch { num_sites: usize, num_labels: usize },
+    /// A site coordinate is NaN or infinite.
+    #[error("site {index} is {position:?}, not finite; remove or repair it")]
+    NonFinite { index: usize, position: [f64; 3] },
+    /// A site is not strictly inside the domain box.
+    #[error("site {index} at {position:?} is not strictly inside the domain box {lo:?}..{hi:?}; move it inside (training clamps sites) or enlarge the box")]
+    OutsideBox { index: usize, position: [f64; 3], lo: [f64; 3], hi: [f64; 3] },
+    /// The domain box is empty or not finite.
+    #[error("the domain box {lo:?}..{hi:?} is empty or not finite")]
+    BadBox { lo: [f64; 3], hi: [f64; 3] },
+    /// The Delaunay tetrahedralization failed.
+    #[error("Delaunay tetrahedralization of the sites failed: {0}")]
+    Delaunay(#[from] delaunay3::DelaunayError),
+    /// A guarantee failed to hold: a bug, reported rather than written out.
+    #[error("internal error, the crust would not be valid: {0}")]
+    Internal(String),
+}
+
+/// Why a sites file could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum SitesFileError {
+    #[error("{path}: cannot read the file ({source})")]
+    Io { path: String, source: std::io::Error },
+    #[error("{path}: {message}")]
+    Invalid { path: String, message: String },
+    #[error(transparent)]
+    Write(#[from] mesh_io::MeshError),
+}

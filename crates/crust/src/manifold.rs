@@ -1,0 +1,239 @@
+//! From Voronoi face polygons to a closed manifold triangle mesh.
+//!
+//! On generic input every Voronoi edge has three cells around it and every Voronoi vertex
+//! four, so the crust is a manifold as it stands. On exactly degenerate input (lattices,
+//! cospherical sets) several tetrahedra share one Voronoi vertex and two inside cells can
+//! touch along an edge or at a point only; there the half-edges around an edge are paired
+//! by angle (each face with its neighbour on its inside side, so each pair bounds one
+//! wedge of solid), and each vertex is split into one copy per umbrella of faces.
+
+use std::collections::HashMap;
+
+use mesh_io::TriMesh;
+
+use crate::error::CrustError;
+
+type V = [f64; 3];
+
+fn sub(a: V, b: V) -> V {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: V, b: V) -> V {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+fn dot(a: V, b: V) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Newell normal of a polygon (not normalised).
+fn newell(poly: &[u32], pos: &[V]) -> V {
+    let mut n = [0.0; 3];
+    for i in 0..poly.len() {
+        let (p, q) = (pos[poly[i] as usize], pos[poly[(i + 1) % poly.len()] as usize]);
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    n
+}
+
+/// Build the mesh. `polygons`: oriented Voronoi faces as ids into `positions`
+/// (#P×3 f64). Returns the mesh, the number of distinct Voronoi vertices used and the
+/// number of extra copies made by splitting.
+pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, usize, usize), CrustError> {
+    // Half-edge h = offset[f] + i goes from polygons[f][i] to polygons[f][i + 1].
+    let mut offset = Vec::with_capacity(polygons.len() + 1);
+    let mut total = 0usize;
+    for p in polygons {
+        offset.push(total);
+        total += p.len();
+    }
+    offset.push(total);
+    let mut face_of = Vec::with_capacity(total);
+    for (f, p) in polygons.iter().enumerate() {
+        face_of.extend(std::iter::repeat_n(f as u32, p.len()));
+    }
+    let from = |h: usize| polygons[face_of[h] as usize][h - offset[face_of[h] as usize]];
+    let next = |h: usize| {
+        let f = face_of[h] as usize;
+        let i = h - offset[f];
+        offset[f] + (i + 1) % polygons[f].len()
+    };
+    let prev = |h: usize| {
+        let f = face_of[h] as usize;
+        let i = h - offset[f];
+        offset[f] + (i + polygons[f].len() - 1) % polygons[f].len()
+    };
+    let to = |h: usize| from(next(h));
+
+    // Group half-edges by undirected edge.
+    let mut groups: HashMap<(u32, u32), Vec<usize>> = HashMap::with_capacity(total / 2);
+    for h in 0..total {
+        let (a, b) = (from(h), to(h));
+        if a == b {
+            return Err(CrustError::Internal(format!("polygon {} repeats a vertex", face_of[h])));
+        }
+        groups.entry((a.min(b), a.max(b))).or_default().push(h);
+    }
+    let mut twin = vec![usize::MAX; total];
+    for (&(u, v), hs) in &groups {
+        let forward = hs.iter().filter(|&&h| from(h) == u).count();
+        if forward * 2 != hs.len() {
+            return Err(CrustError::Internal(format!(
+                "Voronoi edge {u}-{v} has {forward} of {} half-edges one way: the crust would not be closed and oriented",
+                hs.len()
+            )));
+        }
+        if hs.len() == 2 {
+            twin[hs[0]] = hs[1];
+            twin[hs[1]] = hs[0];
+            continue;
+        }
+        pair_around_edge(u, v, hs, positions, polygons, &face_of, &mut twin)?;
+    }
+
+    // Vertex umbrellas: the corner at the start of half-edge h continues, around its
+    // vertex, at the start of twin(prev(h)).
+    let mut corner_vertex = vec![u32::MAX; total];
+    let mut mesh = TriMesh::default();
+    let mut used = vec![false; positions.len()];
+    let mut copies = 0usize;
+    for h0 in 0..total {
+        if corner_vertex[h0] != u32::MAX {
+            continue;
+        }
+        let v = from(h0);
+        let id = mesh.positions.len() as u32;
+        mesh.positions.push(positions[v as usize]);
+        if used[v as usize] {
+            copies += 1;
+        }
+        used[v as usize] = true;
+        let mut h = h0;
+        loop {
+            corner_vertex[h] = id;
+            h = twin[prev(h)];
+            if h == h0 {
+                break;
+            }
+            if corner_vertex[h] != u32::MAX {
+                return Err(CrustError::Internal(format!("vertex {v}: umbrellas do not close")));
+            }
+        }
+    }
+    // Two sheets that touch along an edge can still share both endpoint copies (the
+    // umbrellas at the endpoints connect elsewhere): the paired surface is a manifold, but
+    // two of its edges have the same two vertex ids. Every edge of such a group gets its
+    // own midpoint vertex, inserted in both of its polygons, so edges are told apart by
+    // their ids; the midpoints of one group share a position, so the sheets still meet
+    // only at shared vertex positions.
+    let mut count: HashMap<(u32, u32), u32> = HashMap::with_capacity(total / 2);
+    let key = |h: usize| {
+        let (a, b) = (corner_vertex[h], corner_vertex[twin[h]]);
+        (a.min(b), a.max(b))
+    };
+    for h in 0..total {
+        if twin[h] > h {
+            *count.entry(key(h)).or_insert(0) += 1;
+        }
+    }
+    let mut midpoint_after = vec![u32::MAX; total];
+    for h in 0..total {
+        let g = twin[h];
+        if g < h || count[&key(h)] < 2 {
+            continue;
+        }
+        let (a, b) = (corner_vertex[h], corner_vertex[g]);
+        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+        let w = mesh.positions.len() as u32;
+        mesh.positions.push([0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k])));
+        copies += 1;
+        midpoint_after[h] = w;
+        midpoint_after[g] = w;
+    }
+    let mut ids = Vec::new();
+    for (f, p) in polygons.iter().enumerate() {
+        let o = offset[f];
+        ids.clear();
+        let mut apex = 0;
+        for i in 0..p.len() {
+            ids.push(corner_vertex[o + i]);
+            if midpoint_after[o + i] != u32::MAX {
+                ids.push(midpoint_after[o + i]);
+                // Fan from an inserted midpoint: it lies inside an edge of the convex
+                // polygon, so no fan triangle is degenerate.
+                apex = ids.len() - 1;
+            }
+        }
+        let n = ids.len();
+        for k in 1..n - 1 {
+            let (a, b, c) = (ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]);
+            mesh.triangles.push([a, b, c]);
+        }
+    }
+    let distinct = used.iter().filter(|&&u| u).count();
+    Ok((mesh, distinct, copies))
+}
+
+/// Pair the 2k half-edges around edge (u, v) by the angle of their faces about the edge.
+fn pair_around_edge(
+    u: u32,
+    v: u32,
+    hs: &[usize],
+    positions: &[V],
+    polygons: &[Vec<u32>],
+    face_of: &[u32],
+    twin: &mut [usize],
+) -> Result<(), CrustError> {
+    let pu = positions[u as usize];
+    let axis = sub(positions[v as usize], pu);
+    // An orthonormal-ish frame (e1, e2) perpendicular to the axis.
+    let helper = if axis[0].abs() <= axis[1].abs() && axis[0].abs() <= axis[2].abs() {
+        [1.0, 0.0, 0.0]
+    } else if axis[1].abs() <= axis[2].abs() {
+        [0.0, 1.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let e1 = cross(axis, helper);
+    let e2 = cross(axis, e1);
+    let mut items: Vec<(f64, bool, usize)> = Vec::with_capacity(hs.len());
+    for &h in hs {
+        let poly = &polygons[face_of[h] as usize];
+        // Direction from the edge into the face: its centroid, projected off the axis.
+        let mut c = [0.0; 3];
+        for &w in poly {
+            let p = positions[w as usize];
+            for k in 0..3 {
+                c[k] += p[k] / poly.len() as f64;
+            }
+        }
+        let r = sub(c, pu);
+        let angle = dot(r, e2).atan2(dot(r, e1));
+        // The solid lies on the −normal side of the face. Increasing angle turns by
+        // `axis × r`; the inside wedge is at increasing angle when that agrees with −n.
+        let n = newell(poly, positions);
+        let inside_ccw = dot(cross(axis, r), n) < 0.0;
+        items.push((angle, inside_ccw, h));
+    }
+    items.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let m = items.len();
+    for i in 0..m {
+        let (_, ccw, h) = items[i];
+        if !ccw {
+            continue;
+        }
+        let (_, other_ccw, g) = items[(i + 1) % m];
+        if other_ccw {
+            return Err(CrustError::Internal(format!(
+                "faces around Voronoi edge {u}-{v} do not alternate inside/outside"
+            )));
+        }
+        twin[h] = g;
+        twin[g] = h;
+    }
+    if hs.iter().any(|&h| twin[h] == usize::MAX) {
+        return Err(CrustError::Internal(format!("could not pair the faces around Voronoi edge {u}-{v}")));
+    }
+    Ok(())
+}

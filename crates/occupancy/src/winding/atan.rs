@@ -1,0 +1,99 @@
+//! A fast, accurate `atan2` for the solid-angle sums.
+//!
+//! `f64::atan2` (the platform libm, correctly rounded in glibc) takes about half the time
+//! of a Van Oosterom–Strackee solid angle. This version uses the range reduction and
+//! rational approximation of Cephes' `atan` (S. L. Moshier, *Methods and Programs for
+//! Mathematical Functions*, 1989), accurate to a few units in the last place; tests
+//! compare it with `f64::atan2` over all octants and special values.
+
+// The coefficients are quoted with the digits Cephes publishes, more than f64 holds.
+#![allow(clippy::excessive_precision)]
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+const P: [f64; 5] = [
+    -8.750_608_600_031_904_122_785E-1,
+    -1.615_753_718_733_365_076_637E1,
+    -7.500_855_792_314_704_667_340E1,
+    -1.228_866_684_490_136_173_410E2,
+    -6.485_021_904_942_025_371_773E1,
+];
+const Q: [f64; 5] = [
+    2.485_846_490_142_306_297_962E1,
+    1.650_270_098_316_988_542_046E2,
+    4.328_810_604_912_902_668_951E2,
+    4.853_903_996_359_136_964_868E2,
+    1.945_506_571_482_613_964_425E2,
+];
+/// tan(3π/8).
+const T3P8: f64 = 2.414_213_562_373_095_048_80;
+/// Low bits of π/2 beyond f64 (π/2 − FRAC_PI_2).
+const MOREBITS: f64 = 6.123_233_995_736_765_886_130E-17;
+
+/// atan(x) for x ≥ 0.
+#[inline(always)]
+fn atan_nonneg(x: f64) -> f64 {
+    let (base, x, more) = if x > T3P8 {
+        (FRAC_PI_2, -1.0 / x, MOREBITS)
+    } else if x <= 0.66 {
+        (0.0, x, 0.0)
+    } else {
+        (FRAC_PI_4, (x - 1.0) / (x + 1.0), 0.5 * MOREBITS)
+    };
+    let z = x * x;
+    let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+    let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+    let r = x * (z * p / q) + x;
+    base + (r + more)
+}
+
+/// `atan2(y, x)` in (−π, π], agreeing with `f64::atan2` to a few ulps for finite
+/// arguments (and exactly on the axes, including signed zeros of `y`).
+#[inline(always)]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    if !(x.is_finite() && y.is_finite()) || x == 0.0 {
+        return y.atan2(x);
+    }
+    let a = atan_nonneg((y / x).abs());
+    let a = if x < 0.0 { PI - a } else { a };
+    if y.is_sign_negative() {
+        -a
+    } else {
+        a
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn agrees_with_libm_everywhere() {
+        let mut max_err: f64 = 0.0;
+        let mut state = 12345u64;
+        for i in 0..2_000_000u64 {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let a = ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 4.0;
+            let b = (((state.rotate_left(29)) >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 4.0;
+            let scale = 10f64.powi((i % 13) as i32 - 6);
+            let (y, x) = (a * scale, b);
+            let want = y.atan2(x);
+            let got = atan2(y, x);
+            max_err = max_err.max((got - want).abs() / want.abs().max(1e-300));
+        }
+        assert!(max_err < 1e-15, "max relative error {max_err:e}");
+        for (y, x) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (1.0, 1.0),
+            (1e-300, -1.0),
+            (1e300, 1e-300),
+        ] {
+            assert!((atan2(y, x) - f64::atan2(y, x)).abs() <= 4.0 * f64::EPSILON, "{y} {x}");
+        }
+    }
+}

@@ -1,0 +1,387 @@
+//! Fast generalized winding numbers: Barill, Dickson, Schmidt, Levin, Jacobson, "Fast
+//! Winding Numbers for Soups and Clouds", ACM TOG 37(4), 2018.
+//!
+//! Each BVH node stores the moments of its triangles about its area-weighted centroid
+//! `p̃`; a query `q` farther than `β·R` from `p̃` (`R`: radius of the node's bounding ball
+//! around `p̃`) uses the order-2 Taylor expansion of the dipole field
+//! `f(x) = (x − q) / |x − q|³` around `p̃`, integrated against the normals:
+//!
+//! `∫ f·n dA ≈ r·N/ρ³ + tr(C)/ρ³ − 3 rᵀCr/ρ⁵
+//!            + ½ [−3 (2 r·a + r·b)/ρ⁵ + 15 Σ r_j r_k r_i T_jki / ρ⁷]`
+//!
+//! with `r = p̃ − q`, `ρ = |r|`, `d = x − p̃`, `N = ∫ n dA`, `C_ji = ∫ d_j n_i dA`,
+//! `T_jki = ∫ d_j d_k n_i dA`, `a_j = Σ_k T_jkk`, `b_i = Σ_j T_jji`. The moments are exact
+//! triangle integrals (normals are constant per triangle; `∫ d dA = A s/3` and
+//! `∫ d dᵀ dA = A/12 (Σ_v v vᵀ + s sᵀ)` with `s` the sum of the corners relative to `p̃`),
+//! not point approximations. Nearby leaves are summed exactly with
+//! [`super::solid_angle::solid_angle`].
+
+use rayon::prelude::*;
+
+use super::solid_angle::solid_angle;
+use crate::bvh::TriangleBvh;
+use crate::vec3::{add, cross, dot, scale, sub, V3};
+
+/// Index of the symmetric pair `(j, k)` in the 6-entry packing xx, xy, xz, yy, yz, zz.
+const PAIR: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+
+/// Expansion data of one BVH node (all f64, mesh frame, moments about its centre).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FastNode {
+    /// Area-weighted centroid p̃ of the node's triangles, mesh frame.
+    pub center: V3,
+    /// Squared expansion radius `(β·R)²`, mesh units²: the expansion is used beyond it.
+    pub far_squared: f64,
+    /// The moments used by [`FastNode::eval`].
+    pub moments: Moments,
+}
+
+/// Moments of a node's triangles about its centre p̃ (`d = x − p̃`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Moments {
+    /// `N = Σ ∫ n dA` (area-weighted normal sum), mesh units².
+    pub n: V3,
+    /// `C[3j+i] = ∫ d_j n_i dA`, mesh units³.
+    pub c: [f64; 9],
+    /// `T[3·PAIR[j][k] + i] = ∫ d_j d_k n_i dA`, mesh units⁴.
+    pub t: [f64; 18],
+}
+
+/// The expansion reduced to what the evaluation needs (24 f64 = 3 cache lines): only the
+/// symmetric parts of `C` and `T` contribute, so
+/// `eval = (r·N + tr C)/ρ³ + (−3 rᵀCr − 1.5 r·(2a + b))/ρ⁵ + 7.5 Σ T_jki r_j r_k r_i/ρ⁷`
+/// with the quadratic and cubic forms stored as 6 and 10 monomial coefficients.
+#[derive(Clone, Copy, Debug)]
+pub struct PackedMoments {
+    /// `[N (3), tr C, Q: xx yy zz xy xz yz (6), h = −1.5(2a+b) (3),
+    ///   7.5·P: xxx yyy zzz xxy xxz xyy yyz xzz yzz xyz (10), 0]`.
+    pub k: [f64; 24],
+}
+
+impl Default for PackedMoments {
+    fn default() -> Self {
+        PackedMoments { k: [0.0; 24] }
+    }
+}
+
+impl From<&Moments> for PackedMoments {
+    fn from(m: &Moments) -> Self {
+        let c = &m.c; // c[3j+i] = C_ji
+        let t = |j: usize, k: usize, i: usize| m.t[3 * PAIR[j][k] + i];
+        let a: [f64; 3] = std::array::from_fn(|j| t(j, 0, 0) + t(j, 1, 1) + t(j, 2, 2));
+        let b: [f64; 3] = std::array::from_fn(|i| t(0, 0, i) + t(1, 1, i) + t(2, 2, i));
+        // Coefficient of r_a² r_b in the cubic form: T_aa,b + 2 T_ab,a.
+        let aab = |a: usize, b: usize| t(a, a, b) + 2.0 * t(a, b, a);
+        let mut k = [0.0; 24];
+        k[0..3].copy_from_slice(&m.n);
+        k[3] = c[0] + c[4] + c[8];
+        k[4] = c[0];
+        k[5] = c[4];
+        k[6] = c[8];
+        k[7] = c[1] + c[3];
+        k[8] = c[2] + c[6];
+        k[9] = c[5] + c[7];
+        for j in 0..3 {
+            k[10 + j] = -1.5 * (2.0 * a[j] + b[j]);
+        }
+        let cubic = [
+            t(0, 0, 0),
+            t(1, 1, 1),
+            t(2, 2, 2),
+            aab(0, 1),
+            aab(0, 2),
+            aab(1, 0),
+            aab(1, 2),
+            aab(2, 0),
+            aab(2, 1),
+            2.0 * (t(0, 1, 2) + t(0, 2, 1) + t(1, 2, 0)),
+        ];
+        for (dst, v) in k[13..23].iter_mut().zip(cubic) {
+            *dst = 7.5 * v;
+        }
+        PackedMoments { k }
+    }
+}
+
+impl PackedMoments {
+    /// Same value as [`Moments::eval`], with about half the arithmetic.
+    #[inline(always)]
+    pub fn eval(&self, r: V3, rho2: f64) -> f64 {
+        let k = &self.k;
+        let [x, y, z] = r;
+        let (xx, yy, zz) = (x * x, y * y, z * z);
+        let s3 = x * k[0] + y * k[1] + z * k[2] + k[3];
+        let quad = xx * k[4] + yy * k[5] + zz * k[6] + x * y * k[7] + x * z * k[8] + y * z * k[9];
+        let s5 = -3.0 * quad + x * k[10] + y * k[11] + z * k[12];
+        let s7 = x * (xx * k[13] + yy * k[18] + zz * k[20] + y * z * k[22])
+            + y * (yy * k[14] + xx * k[16] + zz * k[21])
+            + z * (zz * k[15] + xx * k[17] + yy * k[19]);
+        let inv_rho2 = 1.0 / rho2;
+        let inv_rho3 = inv_rho2 * inv_rho2.sqrt();
+        (s3 + (s5 + s7 * inv_rho2) * inv_rho2) * inv_rho3
+    }
+}
+
+/// What the fast traversal reads for every visited node (40 bytes; siblings are adjacent).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct HotNode {
+    /// `[p̃x, p̃y, p̃z, (β·R)²]`, mesh frame / mesh units².
+    pub center_far: [f64; 4],
+    /// Inner node: `[left child, u32::MAX]`; leaf: slot range `[lo, hi)`.
+    pub link: [u32; 2],
+}
+
+/// The expansions of all nodes in two parallel arrays (#nodes each), split so the
+/// traversal's acceptance test touches 40 bytes per node and the 240 bytes of moments
+/// only when a node is expanded.
+#[derive(Clone, Debug, Default)]
+pub struct FastNodes {
+    /// Per node: centre, squared acceptance radius and topology.
+    pub hot: Vec<HotNode>,
+    /// Per node: packed moments about p̃.
+    pub moments: Vec<PackedMoments>,
+}
+
+/// Computes the expansion of every node (parallel over nodes; each node is computed on
+/// its own from its triangles, so results do not depend on the thread count).
+///
+/// - `bvh`: the triangle BVH.
+/// - `beta`: accuracy parameter β (> 1).
+/// - returns: expansions indexed like `bvh`'s nodes.
+///
+/// # Complexity
+/// O(F · depth).
+pub fn build_fast_nodes(bvh: &TriangleBvh, beta: f64) -> FastNodes {
+    let all: Vec<FastNode> = (0..bvh.num_nodes())
+        .into_par_iter()
+        .map(|n| {
+            let [lo, hi] = bvh.range[n];
+            if lo >= hi {
+                return FastNode::default();
+            }
+            node_expansion(&bvh.corners[lo as usize..hi as usize], beta)
+        })
+        .collect();
+    FastNodes {
+        hot: all
+            .iter()
+            .enumerate()
+            .map(|(n, f)| HotNode {
+                center_far: [f.center[0], f.center[1], f.center[2], f.far_squared],
+                link: if bvh.is_leaf(n as u32) { bvh.range[n] } else { [bvh.left_child(n as u32), u32::MAX] },
+            })
+            .collect(),
+        moments: all.iter().map(|f| PackedMoments::from(&f.moments)).collect(),
+    }
+}
+
+fn node_expansion(tris: &[[V3; 3]], beta: f64) -> FastNode {
+    // Area-weighted centroid (falls back to the plain corner mean for zero total area).
+    let mut area_sum = 0.0;
+    let mut weighted = [0.0; 3];
+    let mut mean = [0.0; 3];
+    for t in tris {
+        let an = scale(cross(sub(t[1], t[0]), sub(t[2], t[0])), 0.5);
+        let area = dot(an, an).sqrt();
+        let cen = scale(add(add(t[0], t[1]), t[2]), 1.0 / 3.0);
+        area_sum += area;
+        weighted = add(weighted, scale(cen, area));
+        mean = add(mean, cen);
+    }
+    let center = if area_sum > 0.0 { scale(weighted, 1.0 / area_sum) } else { scale(mean, 1.0 / tris.len() as f64) };
+    let mut node = FastNode { center, ..FastNode::default() };
+    let mut radius_squared: f64 = 0.0;
+    for t in tris {
+        let v = [sub(t[0], center), sub(t[1], center), sub(t[2], center)];
+        for w in v {
+            radius_squared = radius_squared.max(dot(w, w));
+        }
+        // Area vector A·n (the integral of n over the triangle).
+        let an = scale(cross(sub(t[1], t[0]), sub(t[2], t[0])), 0.5);
+        let s = add(add(v[0], v[1]), v[2]);
+        node.moments.n = add(node.moments.n, an);
+        for j in 0..3 {
+            // ∫ d_j dA = A s_j / 3, times the constant normal.
+            for (i, a) in an.iter().enumerate() {
+                node.moments.c[3 * j + i] += s[j] / 3.0 * a;
+            }
+            for k in j..3 {
+                // ∫ d_j d_k dA = A/12 (Σ v_j v_k + s_j s_k).
+                let m = (v[0][j] * v[0][k] + v[1][j] * v[1][k] + v[2][j] * v[2][k] + s[j] * s[k]) / 12.0;
+                let p = PAIR[j][k];
+                for (i, a) in an.iter().enumerate() {
+                    node.moments.t[3 * p + i] += m * a;
+                }
+            }
+        }
+    }
+    let far = beta * radius_squared.sqrt();
+    node.far_squared = far * far;
+    node
+}
+
+impl FastNode {
+    /// See [`Moments::eval`].
+    #[inline(always)]
+    pub fn eval(&self, r: V3, rho2: f64) -> f64 {
+        self.moments.eval(r, rho2)
+    }
+}
+
+impl Moments {
+    /// The order-2 expansion of `∫ (x−q)·n / |x−q|³ dA` over the node (that is, 4π times
+    /// its winding-number contribution), for `r = center − q` and `rho2 = |r|²`.
+    #[inline(always)]
+    pub fn eval(&self, r: V3, rho2: f64) -> f64 {
+        let inv_rho2 = 1.0 / rho2;
+        let inv_rho = inv_rho2.sqrt();
+        let inv_rho3 = inv_rho * inv_rho2;
+        let inv_rho5 = inv_rho3 * inv_rho2;
+        let inv_rho7 = inv_rho5 * inv_rho2;
+        let c = &self.c;
+        let t = &self.t;
+        // Order 0.
+        let order0 = dot(r, self.n) * inv_rho3;
+        // Order 1: tr(C)/ρ³ − 3 rᵀ C r / ρ⁵ with C[3j+i] = C_ji.
+        let trace = c[0] + c[4] + c[8];
+        let mut rcr = 0.0;
+        for j in 0..3 {
+            rcr += r[j] * (c[3 * j] * r[0] + c[3 * j + 1] * r[1] + c[3 * j + 2] * r[2]);
+        }
+        let order1 = trace * inv_rho3 - 3.0 * rcr * inv_rho5;
+        // Order 2.
+        // a_j = Σ_k T_jkk, b_i = Σ_j T_jji.
+        let a = [
+            t[3 * PAIR[0][0]] + t[3 * PAIR[0][1] + 1] + t[3 * PAIR[0][2] + 2],
+            t[3 * PAIR[1][0]] + t[3 * PAIR[1][1] + 1] + t[3 * PAIR[1][2] + 2],
+            t[3 * PAIR[2][0]] + t[3 * PAIR[2][1] + 1] + t[3 * PAIR[2][2] + 2],
+        ];
+        let b = [t[0] + t[9] + t[15], t[1] + t[10] + t[16], t[2] + t[11] + t[17]];
+        // Σ_jk r_j r_k (Σ_i T_jki r_i), symmetric pairs counted twice off the diagonal.
+        let mut tr = [0.0; 6];
+        for (p, tp) in tr.iter_mut().enumerate() {
+            *tp = t[3 * p] * r[0] + t[3 * p + 1] * r[1] + t[3 * p + 2] * r[2];
+        }
+        let rrr = r[0] * r[0] * tr[0]
+            + r[1] * r[1] * tr[3]
+            + r[2] * r[2] * tr[5]
+            + 2.0 * (r[0] * r[1] * tr[1] + r[0] * r[2] * tr[2] + r[1] * r[2] * tr[4]);
+        let order2 = 0.5 * (-3.0 * (2.0 * dot(r, a) + dot(r, b)) * inv_rho5 + 15.0 * rrr * inv_rho7);
+        order0 + order1 + order2
+    }
+}
+
+/// Fast winding number at `q` times 4π (no exact fallback; see
+/// [`MeshOracle::winding_number`](crate::MeshOracle::winding_number) for the guarded
+/// version).
+///
+/// Children are tested from their parent, so accepted nodes are never pushed.
+///
+/// - `q`: query point, mesh frame.
+/// - `stack`: reusable traversal stack (cleared on entry).
+pub(crate) fn fast_solid_angle_sum(bvh: &TriangleBvh, nodes: &FastNodes, q: V3, stack: &mut Vec<u32>) -> f64 {
+    let hot = &nodes.hot[..];
+    let moments = &nodes.moments[..];
+    let corners = &bvh.corners[..];
+    let mut sum = 0.0;
+    stack.clear();
+    stack.push(0);
+    while let Some(n) = stack.pop() {
+        let h = &hot[n as usize];
+        let cf = &h.center_far;
+        let r = [cf[0] - q[0], cf[1] - q[1], cf[2] - q[2]];
+        let rho2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        if rho2 > cf[3] {
+            sum += moments[n as usize].eval(r, rho2);
+        } else if h.link[1] != u32::MAX {
+            for t in &corners[h.link[0] as usize..h.link[1] as usize] {
+                sum += solid_angle(q, t[0], t[1], t[2]);
+            }
+        } else {
+            let l = h.link[0];
+            stack.push(l + 1);
+            stack.push(l);
+        }
+    }
+    sum
+}
+
+/// Work done by one fast query: (nodes visited, expansions evaluated, exact triangles).
+pub(crate) fn fast_traversal_counts(bvh: &TriangleBvh, nodes: &FastNodes, q: V3, stack: &mut Vec<u32>) -> [u64; 3] {
+    stack.clear();
+    stack.push(0);
+    let mut counts = [0u64; 3];
+    while let Some(n) = stack.pop() {
+        counts[0] += 1;
+        let cf = nodes.hot[n as usize].center_far;
+        let r = sub([cf[0], cf[1], cf[2]], q);
+        if dot(r, r) > cf[3] {
+            counts[1] += 1;
+        } else if bvh.is_leaf(n) {
+            let [lo, hi] = bvh.range[n as usize];
+            counts[2] += (hi - lo) as u64;
+        } else {
+            let l = bvh.left_child(n);
+            stack.push(l + 1);
+            stack.push(l);
+        }
+    }
+    counts
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::winding::exact::brute_force_solid_angle_sum;
+
+    /// A deterministic curved patch of triangles inside the unit ball.
+    fn patch() -> Vec<[V3; 3]> {
+        let mut tris = Vec::new();
+        let n = 6;
+        let f = |i: usize, j: usize| {
+            let x = i as f64 / n as f64 * 1.2 - 0.6;
+            let y = j as f64 / n as f64 * 1.2 - 0.6;
+            [x, y, 0.3 * (2.0 * x).sin() * (1.0 + y) + 0.1 * y * y]
+        };
+        for i in 0..n {
+            for j in 0..n {
+                tris.push([f(i, j), f(i + 1, j), f(i + 1, j + 1)]);
+                tris.push([f(i, j), f(i + 1, j + 1), f(i, j + 1)]);
+            }
+        }
+        tris
+    }
+
+    #[test]
+    fn packed_evaluation_equals_the_tensor_formula() {
+        let node = node_expansion(&patch(), 2.0);
+        let packed = PackedMoments::from(&node.moments);
+        for q in [[3.0, -1.0, 2.0], [0.1, 4.0, -0.3], [-5.0, -5.0, 5.0], [0.0, 0.2, 2.5]] {
+            let r = sub(node.center, q);
+            let a = node.eval(r, dot(r, r));
+            let b = packed.eval(r, dot(r, r));
+            assert!((a - b).abs() <= 1e-13 * a.abs().max(1e-3), "{q:?}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn expansion_error_decays_like_order_three() {
+        // Truncating after order 2 leaves an error ∝ ρ⁻⁵ (contribution ρ⁻² times (R/ρ)³),
+        // so doubling the distance must divide the error by about 32; a wrong order-2 term
+        // would only give 16.
+        let tris = patch();
+        let node = node_expansion(&tris, 2.0);
+        let dir = [0.48, -0.6, 0.64];
+        let mut errors = Vec::new();
+        for rho in [8.0, 16.0, 32.0] {
+            let q = sub(node.center, scale(dir, rho));
+            let r = sub(node.center, q);
+            let approx = node.eval(r, dot(r, r));
+            let exact = brute_force_solid_angle_sum(&tris, q);
+            errors.push((approx - exact).abs());
+        }
+        let ratio1 = errors[0] / errors[1];
+        let ratio2 = errors[1] / errors[2];
+        assert!(ratio1 > 26.0 && ratio2 > 26.0, "{errors:?} {ratio1} {ratio2}");
+    }
+}

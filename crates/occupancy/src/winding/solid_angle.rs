@@ -1,0 +1,54 @@
+//! Signed solid angle of one triangle seen from a point.
+
+use crate::vec3::{dot, norm, V3};
+
+/// Signed solid angle Ω (steradians) subtended by triangle `(a, b, c)` at the point `q`,
+/// by the formula of Van Oosterom and Strackee (1983), "The solid angle of a plane
+/// triangle", IEEE Trans. Biomed. Eng. 30(2):
+///
+/// `tan(Ω/2) = det[a−q, b−q, c−q] / (|a||b||c| + (a·b)|c| + (b·c)|a| + (c·a)|b|)`
+/// (with `a` standing for `a−q` etc.), evaluated with `atan2` so Ω ∈ (−2π, 2π].
+///
+/// - `q`, `a`, `b`, `c`: points in the mesh frame, f64.
+/// - returns: Ω in steradians; positive when the triangle is counter-clockwise seen from
+///   `q`'s side opposite its normal, i.e. a point inside a closed mesh whose triangles are
+///   counter-clockwise seen from outside sums to +4π. Matches `igl::solid_angle` (which
+///   returns Ω/4π) operation by operation.
+#[inline(always)]
+pub fn solid_angle(q: V3, a: V3, b: V3, c: V3) -> f64 {
+    let va = [a[0] - q[0], a[1] - q[1], a[2] - q[2]];
+    let vb = [b[0] - q[0], b[1] - q[1], b[2] - q[2]];
+    let vc = [c[0] - q[0], c[1] - q[1], c[2] - q[2]];
+    let la = norm(va);
+    let lb = norm(vb);
+    let lc = norm(vc);
+    // Same expansion of the determinant as libigl's solid_angle.cpp.
+    let det = va[0] * vb[1] * vc[2] + vb[0] * vc[1] * va[2] + vc[0] * va[1] * vb[2]
+        - vc[0] * vb[1] * va[2]
+        - vb[0] * va[1] * vc[2]
+        - va[0] * vc[1] * vb[2];
+    let denom = la * lb * lc + dot(vb, vc) * la + dot(vc, va) * lb + dot(va, vb) * lc;
+    2.0 * super::atan::atan2(det, denom)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn octant_triangle_is_one_eighth_of_sphere() {
+        // The triangle (e_x, e_y, e_z) seen from the origin covers one octant: 4π/8.
+        let w = solid_angle([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+        assert!((w - PI / 2.0).abs() < 1e-15, "{w}");
+        // Reversed orientation flips the sign.
+        let w = solid_angle([0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]);
+        assert!((w + PI / 2.0).abs() < 1e-15, "{w}");
+    }
+
+    #[test]
+    fn coplanar_point_outside_gives_zero() {
+        let w = solid_angle([5.0, 5.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        assert_eq!(w, 0.0);
+    }
+}

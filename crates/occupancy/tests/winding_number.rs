@@ -1,0 +1,198 @@
+//! Winding numbers: exact hierarchical sum vs brute force, known values on closed meshes,
+//! fast mode accuracy and flips on the issue's query sets.
+
+mod common;
+
+use occupancy::winding::exact::brute_force_solid_angle_sum;
+use occupancy::{Config, MeshOracle, WindingMode, Workspace};
+
+fn corners(mesh: &common::Mesh) -> Vec<[[f64; 3]; 3]> {
+    mesh.1.iter().map(|t| t.map(|v| mesh.0[v as usize])).collect()
+}
+
+#[test]
+fn bvh_validates_on_every_class() {
+    for (name, mesh) in common::meshes_by_class() {
+        let oracle = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+        assert_eq!(oracle.bvh().validate(), Ok(()), "{name}");
+        assert_eq!(oracle.validate(), Ok(()), "{name}");
+        assert_eq!(oracle.num_triangles(), mesh.1.len());
+    }
+}
+
+#[test]
+fn exact_hierarchical_sum_equals_brute_force_on_every_class() {
+    for (name, mesh) in common::meshes_by_class() {
+        let oracle = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+        let tris = corners(&mesh);
+        let queries = common::issue_queries(&mesh, 1500, 7);
+        let mut ws = Workspace::new();
+        let mut max_diff: f64 = 0.0;
+        for q in &queries {
+            let w = oracle.winding_number_exact(*q, &mut ws);
+            let b = brute_force_solid_angle_sum(&tris, *q) / (4.0 * std::f64::consts::PI);
+            max_diff = max_diff.max((w - b).abs());
+        }
+        assert!(max_diff < 1e-10, "{name}: max |hierarchical - brute| = {max_diff:e}");
+    }
+}
+
+#[test]
+fn closed_meshes_have_winding_one_inside_and_zero_outside() {
+    let sphere = common::icosphere(3);
+    let oracle = MeshOracle::new(&sphere.0, &sphere.1, &Config::default()).unwrap();
+    let mut ws = Workspace::new();
+    for (q, want) in [
+        ([0.0, 0.0, 0.0], 1.0),
+        ([0.5, -0.3, 0.2], 1.0),
+        ([0.0, 0.0, 0.98], 1.0),
+        ([1.2, 0.0, 0.0], 0.0),
+        ([0.0, 1.05, 0.1], 0.0),
+        ([3.0, -4.0, 5.0], 0.0),
+    ] {
+        for mode in [WindingMode::Exact, WindingMode::Fast] {
+            let w = oracle.winding_number(q, mode, &mut ws);
+            let tol = if mode == WindingMode::Exact { 1e-12 } else { 1e-3 };
+            assert!((w - want).abs() < tol, "{q:?} {mode:?}: {w}");
+        }
+    }
+    // Torus: inside the tube is 1, in the hole is 0.
+    let torus = common::torus(48, 24);
+    let oracle = MeshOracle::new(&torus.0, &torus.1, &Config::default()).unwrap();
+    let w_tube = oracle.winding_number_exact([1.0, 0.0, 0.0], &mut ws);
+    let w_hole = oracle.winding_number_exact([0.0, 0.0, 0.0], &mut ws);
+    // The torus' quads are ordered so that its normals point inward or outward depending
+    // on the parametrisation; whichever, |w| is 1 in the tube and 0 in the hole.
+    assert!((w_tube.abs() - 1.0).abs() < 1e-12, "{w_tube}");
+    assert!(w_hole.abs() < 1e-12, "{w_hole}");
+}
+
+#[test]
+fn reversing_orientation_negates_winding() {
+    let (p, t) = common::icosphere(2);
+    let flipped: Vec<[u32; 3]> = t.iter().map(|x| [x[0], x[2], x[1]]).collect();
+    let a = MeshOracle::new(&p, &t, &Config::default()).unwrap();
+    let b = MeshOracle::new(&p, &flipped, &Config::default()).unwrap();
+    let queries = common::issue_queries(&(p.clone(), t.clone()), 500, 3);
+    let wa = a.winding_numbers(&queries, WindingMode::Exact).unwrap();
+    let wb = b.winding_numbers(&queries, WindingMode::Exact).unwrap();
+    for (x, y) in wa.iter().zip(&wb) {
+        assert!((x + y).abs() < 1e-12, "{x} {y}");
+    }
+}
+
+#[test]
+fn unwelded_soup_has_the_same_winding_as_the_welded_mesh() {
+    // Regression guard for the boundary caps: an STL-style soup must weld its edges so
+    // caps cancel, and in any case give the same numbers.
+    let mesh = common::icosphere(3);
+    let soup = common::unweld(&mesh);
+    let a = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+    let b = MeshOracle::new(&soup.0, &soup.1, &Config::default()).unwrap();
+    assert_eq!(a.num_cap_edges(), b.num_cap_edges());
+    let queries = common::issue_queries(&mesh, 2000, 5);
+    for mode in [WindingMode::Exact, WindingMode::Fast] {
+        let wa = a.winding_numbers(&queries, mode).unwrap();
+        let wb = b.winding_numbers(&queries, mode).unwrap();
+        for (x, y) in wa.iter().zip(&wb) {
+            assert!((x - y).abs() < 1e-12, "{mode:?}: {x} {y}");
+        }
+    }
+}
+
+#[test]
+fn open_mesh_winding_is_fractional_near_the_hole() {
+    // A hemisphere-like open cap: the winding number varies continuously through the hole,
+    // taking values strictly between 0 and 1 there.
+    let (p, t) = common::icosphere(3);
+    let open: Vec<[u32; 3]> =
+        t.iter().copied().filter(|tri| tri.iter().map(|&v| p[v as usize][2]).sum::<f64>() / 3.0 < 0.0).collect();
+    let oracle = MeshOracle::new(&p, &open, &Config::default()).unwrap();
+    let mut ws = Workspace::new();
+    let w = oracle.winding_number_exact([0.0, 0.0, 0.0], &mut ws);
+    assert!((w - 0.5).abs() < 0.05, "{w}");
+    // Fast mode falls back to exact so close to 0.5.
+    let wf = oracle.winding_number([0.0, 0.0, 0.0], WindingMode::Fast, &mut ws);
+    assert_eq!(wf, w);
+    assert_eq!(ws.num_exact_fallbacks, 1);
+}
+
+/// Number of queries per mesh of the issue's accuracy test: `VF_OCC_QUERIES`, default
+/// 250,000 to keep the suite quick; the issue's full 1,000,000 runs with
+/// `VF_OCC_QUERIES=1000000` (about a minute in release on two idle cores; results in the
+/// crate README).
+fn issue_query_count() -> usize {
+    std::env::var("VF_OCC_QUERIES").ok().and_then(|s| s.parse().ok()).unwrap_or(1_000_000)
+}
+
+#[test]
+fn fast_winding_error_below_1e_3_and_no_flips_on_issue_query_sets() {
+    let n = issue_query_count();
+    let mut meshes = vec![("icosphere20480".to_string(), common::icosphere(5))];
+    for name in ["mikedh__bunny.ply", "mikedh__teapot.stl"] {
+        match common::shared_mesh(name) {
+            Some(m) => meshes.push((name.to_string(), m)),
+            None => eprintln!("skipping {name}: shared meshes not found"),
+        }
+    }
+    for (name, mesh) in meshes {
+        let config = Config::default();
+        let guarded = MeshOracle::new(&mesh.0, &mesh.1, &config).unwrap();
+        let raw = MeshOracle::new(&mesh.0, &mesh.1, &Config { exact_fallback_margin: 0.0, ..config.clone() }).unwrap();
+        let queries = common::issue_queries(&mesh, n, 2024);
+        let exact = guarded.winding_numbers(&queries, WindingMode::Exact).unwrap();
+        // The raw approximation on all queries: its error is the issue's bound.
+        let fast_raw = raw.winding_numbers(&queries, WindingMode::Fast).unwrap();
+        let max_err = fast_raw.iter().zip(&exact).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        // The guarded mode differs from the raw one only within the fallback band, so it is
+        // run through its real code path on every query of the band and on a sample of the
+        // others.
+        let mut ws = Workspace::new();
+        let mut flips = 0;
+        let mut num_band = 0;
+        for (i, q) in queries.iter().enumerate() {
+            let in_band = (fast_raw[i] - config.occupancy_threshold).abs() < config.exact_fallback_margin;
+            if !in_band && i % 97 != 0 {
+                continue;
+            }
+            num_band += in_band as usize;
+            let w = guarded.winding_number(*q, WindingMode::Fast, &mut ws);
+            if in_band {
+                assert_eq!(w, exact[i], "{name}: band query {i} not recomputed exactly");
+            } else {
+                assert_eq!(w, fast_raw[i], "{name}: query {i} outside the band changed");
+            }
+            flips += ((w >= 0.5) != (exact[i] >= 0.5)) as usize;
+        }
+        assert_eq!(ws.num_exact_fallbacks as usize, num_band);
+        eprintln!(
+            "{name}: {n} queries, max |fast - exact| = {max_err:.3e}, {num_band} in the exact \
+             fallback band, flips = {flips}"
+        );
+        assert!(max_err <= 1e-3, "{name}: max error {max_err:e}");
+        assert_eq!(flips, 0, "{name}");
+        // Outside the band the raw value already decides correctly.
+        let raw_flips_outside_band = fast_raw
+            .iter()
+            .zip(&exact)
+            .filter(|(a, b)| (**a - 0.5).abs() >= config.exact_fallback_margin && (**a >= 0.5) != (**b >= 0.5))
+            .count();
+        assert_eq!(raw_flips_outside_band, 0, "{name}");
+    }
+}
+
+#[test]
+fn query_batch_columns_agree() {
+    let mesh = common::icosphere(3);
+    let oracle = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+    let queries = common::issue_queries(&mesh, 5000, 9);
+    let batch = oracle.query(&queries, WindingMode::Fast).unwrap();
+    let w = oracle.winding_numbers(&queries, WindingMode::Fast).unwrap();
+    let c = oracle.closest_points(&queries).unwrap();
+    assert_eq!(batch.winding, w);
+    for i in 0..queries.len() {
+        assert_eq!(batch.occupancy[i], (w[i] >= 0.5) as u8);
+        assert_eq!(batch.squared_distance[i], c[i].squared_distance);
+        assert_eq!(batch.closest[i], c[i].point);
+    }
+}

@@ -1,0 +1,118 @@
+//! `voronoi-fit crust SITES.npz -o CRUST.glb [--cells CELLS.glb] [--json]`: the watertight
+//! crust (and optionally the convex inside cells) of a sites file, in the mesh frame.
+
+use std::path::PathBuf;
+
+use anyhow::anyhow;
+use crust::{check::check_crust, Crust, CrustConfig, CrustError, SitesFile};
+use mesh_io::{GltfLayout, SceneMesh, TriMesh};
+
+use crate::cli_error::CliError;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Sites file (.npz with sites, labels, transform, format_version; see the README).
+    pub sites: PathBuf,
+    /// Output crust: .glb, .gltf, .obj or .ply (by extension).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write every inside cell as a closed convex polyhedron, one node per cell (.glb
+    /// or .gltf).
+    #[arg(long)]
+    pub cells: Option<PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn check_output_ext(path: &std::path::Path, allowed: &[&str]) -> Result<(), CliError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    if !allowed.contains(&ext.as_str()) {
+        return Err(CliError::BadInput(anyhow!(
+            "{}: the output must end in {}",
+            path.display(),
+            allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
+        )));
+    }
+    Ok(())
+}
+
+/// Map a unit-cube mesh to the mesh frame; flip triangles if the map mirrors.
+fn to_mesh_frame(file: &SitesFile, mesh: &TriMesh) -> TriMesh {
+    let m = &file.transform;
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    TriMesh {
+        positions: mesh.positions.iter().map(|&p| file.to_mesh_frame(p)).collect(),
+        triangles: mesh.triangles.iter().map(|t| if det < 0.0 { [t[0], t[2], t[1]] } else { *t }).collect(),
+    }
+}
+
+pub fn run(args: Args) -> Result<(), CliError> {
+    check_output_ext(&args.output, &["glb", "gltf", "obj", "ply"])?;
+    if let Some(c) = &args.cells {
+        check_output_ext(c, &["glb", "gltf"])?;
+    }
+    let file = SitesFile::read(&args.sites).map_err(|e| CliError::BadInput(e.into()))?;
+    let mut crust = Crust::extract(&file.sites, &file.inside, &CrustConfig::default()).map_err(|e| match e {
+        CrustError::Internal(_) => CliError::Failure(anyhow!("{}: {e}", args.sites.display())),
+        e => CliError::BadInput(anyhow!("{}: {e}", args.sites.display())),
+    })?;
+    // The guarantees are checked before anything is written.
+    let check = check_crust(&crust.mesh).map_err(|e| {
+        CliError::Failure(anyhow!("{}: the crust failed its check ({e}); please report this", args.sites.display()))
+    })?;
+    let out = to_mesh_frame(&file, &crust.mesh);
+    mesh_io::write_mesh(&args.output, &out)?;
+    let mut num_cells = 0;
+    if let Some(path) = &args.cells {
+        let cells = crust.cells().map_err(|e| CliError::Failure(e.into()))?;
+        num_cells = cells.len();
+        let meshes: Vec<(String, TriMesh)> =
+            cells.iter().map(|(i, m)| (format!("cell {i}"), to_mesh_frame(&file, m))).collect();
+        let scene: Vec<SceneMesh> = meshes.iter().map(|(name, mesh)| SceneMesh { name, mesh, colors: None }).collect();
+        let layout = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf")) {
+            GltfLayout::Separate
+        } else {
+            GltfLayout::Binary
+        };
+        mesh_io::write_gltf(path, &scene, layout)?;
+    }
+    let s = &crust.stats;
+    let volume = mesh_io::TopologyReport::of(&out).signed_volume;
+    if args.json {
+        let j = serde_json::json!({
+            "sites": args.sites.display().to_string(),
+            "output": args.output.display().to_string(),
+            "num_sites": s.num_sites,
+            "num_inside": s.num_inside,
+            "num_mirrors": s.num_mirrors,
+            "num_delaunay_passes": s.num_delaunay_passes,
+            "num_polygons": s.num_polygons,
+            "num_vertices": out.positions.len(),
+            "num_triangles": out.triangles.len(),
+            "num_split_vertices": s.num_split_vertices,
+            "num_cells": num_cells,
+            "genus": check.report.genus,
+            "num_components": check.report.num_components,
+            "volume": volume,
+            "delaunay_seconds": s.delaunay_seconds,
+            "total_seconds": s.total_seconds,
+        });
+        crate::output::out!("{}", serde_json::to_string_pretty(&j).map_err(anyhow::Error::from)?);
+    } else {
+        crate::output::out!(
+            "{}: {} sites ({} inside) -> crust of {} triangles, {} vertices, {} component(s), genus {}, volume {:.6e} (mesh units), closed and manifold, checked; {:.3} s.",
+            args.output.display(),
+            s.num_sites,
+            s.num_inside,
+            out.triangles.len(),
+            out.positions.len(),
+            check.report.num_components,
+            check.report.genus.map_or("n/a".to_string(), |g| g.to_string()),
+            volume,
+            s.total_seconds
+        );
+    }
+    Ok(())
+}

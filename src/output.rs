@@ -1,0 +1,23 @@
+//! Standard output that survives a closed pipe: `voronoi-fit info MESH | head` must not
+//! panic when `head` exits (println! panics on EPIPE).
+
+use std::io::Write;
+
+/// Write one line to stdout; exit quietly (code 0) if the reader has gone away, with
+/// code 1 on any other write error.
+pub fn write_line(args: std::fmt::Arguments) {
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|_| out.write_all(b"\n")).and_then(|_| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: cannot write to standard output ({e})");
+        std::process::exit(1);
+    }
+}
+
+/// `println!` that handles a closed pipe (see [`write_line`]).
+macro_rules! out {
+    ($($t:tt)*) => { $crate::output::write_line(format_args!($($t)*)) };
+}
+pub(crate) use out;
