@@ -32,11 +32,16 @@ pub fn run(args: Args) -> Result<(), CliError> {
     crate::output::out!("  vertices            {} ({} referenced)", r.num_vertices, r.num_referenced_vertices);
     crate::output::out!(
         "  faces               {} ({} degenerate, {} duplicate)",
-        r.num_faces, r.num_degenerate_faces, r.num_duplicate_faces
+        r.num_faces,
+        r.num_degenerate_faces,
+        r.num_duplicate_faces
     );
     crate::output::out!(
         "  edges               {} ({} boundary in {} loops, {} non-manifold)",
-        r.num_edges, r.num_boundary_edges, r.num_boundary_loops, r.num_non_manifold_edges
+        r.num_edges,
+        r.num_boundary_edges,
+        r.num_boundary_loops,
+        r.num_non_manifold_edges
     );
     crate::output::out!("  non-manifold verts  {}", r.num_non_manifold_vertices);
     crate::output::out!("  components          {}", r.num_components);

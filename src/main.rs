@@ -18,7 +18,11 @@ use clap::{Parser, Subcommand};
 use cli_error::CliError;
 
 #[derive(Parser)]
-#[command(name = "voronoi-fit", version, about = "Turn a triangle mesh into labelled Voronoi sites and back into a watertight crust")]
+#[command(
+    name = "voronoi-fit",
+    version,
+    about = "Turn a triangle mesh into labelled Voronoi sites and back into a watertight crust"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

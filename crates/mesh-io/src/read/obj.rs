@@ -11,12 +11,7 @@ use crate::error::{ErrorKind, Location, MeshError, Result};
 use crate::TriMesh;
 
 pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
-    let options = tobj::LoadOptions {
-        single_index: false,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
+    let options = tobj::LoadOptions { single_index: false, triangulate: true, ignore_points: true, ignore_lines: true };
     let mut reader = std::io::BufReader::new(bytes);
     // Materials are irrelevant to geometry: a missing .mtl must not fail the load.
     let loaded = tobj::load_obj_buf(&mut reader, &options, |_| Err(tobj::LoadError::OpenFileFailed));
