@@ -1,5 +1,8 @@
 """The topology report against trimesh, and every GLB/glTF the CLI writes against the
 Khronos validator, for every mesh of the corpus."""
+import os
+from pathlib import Path
+
 import numpy as np
 import pytest
 import trimesh
@@ -74,3 +77,19 @@ def test_normalized_output_fits_the_unit_cube(bin_path, tmp_path, path):
     lo, hi = m.bounds
     assert lo.min() >= 0.1 - 1e-12 and hi.max() <= 0.9 + 1e-12
     assert abs(np.ptp(m.vertices, axis=0).max() - 0.8) < 1e-12
+
+
+def glbs_written_by_rust_tests():
+    d = os.environ.get("VF_GLB_OUT")
+    return sorted(p for p in Path(d).rglob("*") if p.suffix in (".glb", ".gltf")) if d else []
+
+
+def test_rust_tests_left_gltf_files_to_validate():
+    if "VF_GLB_OUT" not in os.environ:
+        pytest.skip("run through tests/run.sh, which sets VF_GLB_OUT for cargo test")
+    assert len(glbs_written_by_rust_tests()) >= 3
+
+
+@pytest.mark.parametrize("path", glbs_written_by_rust_tests(), ids=lambda p: p.name)
+def test_gltf_written_by_rust_tests_is_valid(path):
+    assert_gltf_valid(path)

@@ -20,6 +20,25 @@ fn triangle_set(m: &TriMesh) -> Vec<[[u64; 3]; 3]> {
     m.canonical_triangles()
 }
 
+/// When the test runner sets VF_GLB_OUT, keep a copy of a written glTF/GLB (and its .bin)
+/// there: tests/reference/test_mesh_io.py runs the Khronos validator on every one.
+fn keep_for_validation(path: &Path, tag: &str) {
+    let Some(dir) = std::env::var_os("VF_GLB_OUT") else { return };
+    let dir = PathBuf::from(dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let name = path.file_name().unwrap().to_string_lossy().into_owned();
+    std::fs::copy(path, dir.join(format!("{tag}_{name}"))).unwrap();
+    let bin = path.with_extension("bin");
+    if name.ends_with(".gltf") && bin.exists() {
+        // The .gltf names its .bin: keep the pair in a folder of its own.
+        let sub = dir.join(tag);
+        std::fs::create_dir_all(&sub).unwrap();
+        std::fs::copy(path, sub.join(&name)).unwrap();
+        std::fs::copy(&bin, sub.join(bin.file_name().unwrap())).unwrap();
+        std::fs::remove_file(dir.join(format!("{tag}_{name}"))).unwrap();
+    }
+}
+
 fn f32_rounded(m: &TriMesh) -> TriMesh {
     TriMesh {
         positions: m.positions.iter().map(|p| p.map(|c| c as f32 as f64)).collect(),
@@ -50,6 +69,9 @@ fn every_writer_round_trips_an_icosphere() {
     for ext in ["obj", "ply", "glb", "gltf"] {
         let p = d.path().join(format!("s.{ext}"));
         write_mesh(&p, &m).unwrap();
+        if ext.starts_with("gl") {
+            keep_for_validation(&p, "icosphere");
+        }
         let back = read_mesh(&p).unwrap();
         let want = if ext.starts_with("gl") { f32_rounded(&m) } else { m.clone() };
         assert_eq!(triangle_set(&back), triangle_set(&want), "{ext}");
@@ -188,6 +210,7 @@ fn gltf_scene_with_several_nodes_and_colours_reads_back() {
         GltfLayout::Binary,
     )
     .unwrap();
+    keep_for_validation(&p, "scene_with_colours");
     let back = read_mesh(&p).unwrap();
     assert_eq!(back.triangles.len(), a.triangles.len() + b.triangles.len());
     let r = TopologyReport::of(&back);

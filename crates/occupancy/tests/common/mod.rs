@@ -118,73 +118,11 @@ pub fn read_ascii_ply(bytes: &[u8]) -> Mesh {
     (positions, triangles)
 }
 
-/// Unit icosphere with `20·4^subdivisions` faces, counter-clockwise seen from outside.
+/// Unit icosphere with `20·4^subdivisions` faces, counter-clockwise seen from outside
+/// (`mesh_io::shapes::icosphere`).
 pub fn icosphere(subdivisions: u32) -> Mesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut positions: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let norm = |p: [f64; 3]| {
-        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        [p[0] / l, p[1] / l, p[2] / l]
-    };
-    for p in positions.iter_mut() {
-        *p = norm(*p);
-    }
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdivisions {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut next = Vec::with_capacity(triangles.len() * 4);
-        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<[f64; 3]>| {
-            let key = (a.min(b), a.max(b));
-            *mid.entry(key).or_insert_with(|| {
-                let pa = positions[a as usize];
-                let pb = positions[b as usize];
-                positions.push(norm([(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0, (pa[2] + pb[2]) / 2.0]));
-                (positions.len() - 1) as u32
-            })
-        };
-        for [a, b, c] in triangles {
-            let ab = midpoint(a, b, &mut positions);
-            let bc = midpoint(b, c, &mut positions);
-            let ca = midpoint(c, a, &mut positions);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    (positions, triangles)
+    let m = mesh_io::shapes::icosphere(subdivisions);
+    (m.positions, m.triangles)
 }
 
 /// Welded two-torus-like genus-1 mesh: a torus with radii (1, 0.35), `nu`×`nv` quads.
