@@ -39,12 +39,10 @@ fn check_output_ext(path: &std::path::Path, allowed: &[&str]) -> Result<(), CliE
 
 /// Map a unit-cube mesh to the mesh frame; flip triangles if the map mirrors.
 fn to_mesh_frame(file: &SitesFile, mesh: &TriMesh) -> TriMesh {
-    let m = &file.transform;
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    let flip = file.transform_mirrors();
     TriMesh {
         positions: mesh.positions.iter().map(|&p| file.to_mesh_frame(p)).collect(),
-        triangles: mesh.triangles.iter().map(|t| if det < 0.0 { [t[0], t[2], t[1]] } else { *t }).collect(),
+        triangles: mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect(),
     }
 }
 

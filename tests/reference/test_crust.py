@@ -88,3 +88,11 @@ def test_bad_sites_files_exit_2_without_output(bin_path, tmp_path, broken):
     assert r.returncode == 2, r.stderr
     assert str(f) in r.stderr
     assert not out.exists()
+
+
+def test_a_mirroring_transform_keeps_the_crust_outward(bin_path, tmp_path):
+    sites, labels = CASES["uniform_ball"]
+    write_sites(tmp_path / "s.npz", sites, labels, np.diag([-1.0, 1.0, 1.0, 1.0]))
+    run("crust", tmp_path / "s.npz", "-o", tmp_path / "c.ply")
+    m = trimesh.load(str(tmp_path / "c.ply"), process=False)
+    assert m.is_watertight and m.is_winding_consistent and m.volume > 0

@@ -40,6 +40,12 @@ impl SitesFile {
         [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
     }
 
+    /// Whether `transform` mirrors (negative determinant of its linear part): triangles
+    /// mapped through it must have their winding flipped to stay counter-clockwise.
+    pub fn transform_mirrors(&self) -> bool {
+        linear_determinant(&self.transform) < 0.0
+    }
+
     /// Read and check a sites file.
     ///
     /// # Errors
@@ -88,10 +94,7 @@ impl SitesFile {
                 transform[r][c] = t[(r, c)];
             }
         }
-        let det3 = transform[0][0] * (transform[1][1] * transform[2][2] - transform[1][2] * transform[2][1])
-            - transform[0][1] * (transform[1][0] * transform[2][2] - transform[1][2] * transform[2][0])
-            + transform[0][2] * (transform[1][0] * transform[2][1] - transform[1][1] * transform[2][0]);
-        if det3 == 0.0 || transform[3] != [0.0, 0.0, 0.0, 1.0] {
+        if linear_determinant(&transform) == 0.0 || transform[3] != [0.0, 0.0, 0.0, 1.0] {
             return Err(invalid("`transform` must be an invertible affine matrix with last row (0, 0, 0, 1)".into()));
         }
         let mut out = Vec::with_capacity(sites.nrows());
@@ -124,4 +127,10 @@ impl SitesFile {
         mesh_io::atomic_write(path, |out| out.write_all(&bytes))?;
         Ok(())
     }
+}
+
+/// Determinant of the upper-left 3×3 block of a row-major 4×4 matrix.
+fn linear_determinant(m: &[[f64; 4]; 4]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
