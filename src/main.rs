@@ -8,6 +8,8 @@ mod cli_error;
 mod cmd_convert;
 mod cmd_crust;
 mod cmd_delaunay;
+mod cmd_eval;
+mod cmd_fit;
 mod cmd_info;
 mod cmd_query;
 mod cmd_sample;
@@ -21,15 +23,24 @@ use cli_error::CliError;
 #[command(
     name = "voronoi-fit",
     version,
-    about = "Turn a triangle mesh into labelled Voronoi sites and back into a watertight crust"
+    about = "Turn a triangle mesh into labelled Voronoi sites and back into a watertight crust",
+    long_about = "Turn a triangle mesh into labelled Voronoi sites and back into a watertight crust.\n\n\
+                  `voronoi-fit MESH` runs the main job (the same as `voronoi-fit fit MESH`): train the sites, \
+                  write MESH-stem.voronoi.glb, .sites.npz and .report.json. The subcommands run single stages.",
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
 )]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    #[command(flatten)]
+    fit: Option<cmd_fit::Args>,
 }
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: fit Voronoi sites to a mesh, write the crust, sites and report.
+    Fit(cmd_fit::Args),
     /// Print the topology report of a mesh (counts, boundary, manifoldness, genus, volume).
     Info(cmd_info::Args),
     /// Convert a mesh to GLB, glTF, OBJ or PLY (optionally normalised into the unit cube).
@@ -43,6 +54,9 @@ enum Command {
     Delaunay(cmd_delaunay::Args),
     /// Watertight crust (and optionally the convex inside cells) of a sites file.
     Crust(cmd_crust::Args),
+    /// Reconstruction metrics of a predicted mesh against a reference: certified and
+    /// libigl-compatible Hausdorff, Chamfer, F-score, normal consistency, IoU, validity.
+    Eval(cmd_eval::Args),
 }
 
 fn main() {
@@ -54,13 +68,23 @@ fn main() {
             std::process::exit(if e.use_stderr() { 2 } else { 0 });
         }
     };
-    let result: Result<(), CliError> = match cli.command {
+    let command = match (cli.command, cli.fit) {
+        (Some(c), _) => c,
+        (None, Some(fit)) => Command::Fit(fit),
+        (None, None) => {
+            eprintln!("error: give a mesh to fit (voronoi-fit MESH) or a subcommand; see voronoi-fit --help");
+            std::process::exit(2);
+        }
+    };
+    let result: Result<(), CliError> = match command {
+        Command::Fit(args) => cmd_fit::run(args),
         Command::Info(args) => cmd_info::run(args),
         Command::Convert(args) => cmd_convert::run(args),
         Command::Sample(args) => cmd_sample::run(args),
         Command::Query(args) => cmd_query::run(args),
         Command::Delaunay(args) => cmd_delaunay::run(args),
         Command::Crust(args) => cmd_crust::run(args),
+        Command::Eval(args) => cmd_eval::run(args),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");

@@ -23,7 +23,7 @@ pub mod config;
 pub mod distance;
 pub mod error;
 pub mod oracle;
-mod order;
+pub mod order;
 pub mod sample;
 mod vec3;
 pub mod winding;

@@ -91,3 +91,101 @@ pub(crate) fn closest_point_slot(
     let c = ClosestPoint { point: best_point, squared_distance: best_d2, triangle: bvh.tri_ids[best_slot as usize] };
     (c, best_slot)
 }
+
+impl TriangleBvh {
+    /// Builds a BVH for closest-point queries only, without the winding-number data of
+    /// [`crate::MeshOracle`] (faster to build; used by the `metrics` crate).
+    ///
+    /// - `positions`: #V×3 f64, any frame; every coordinate finite with magnitude ≤
+    ///   [`crate::MAX_COORDINATE`].
+    /// - `triangles`: #F×3 u32 zero-based; degenerate and duplicate triangles accepted.
+    /// - `config`: only `bvh_preset` and `max_leaf_size` are used.
+    ///
+    /// # Errors
+    /// As [`crate::MeshOracle::new`]: [`crate::OccupancyError::NoTriangles`],
+    /// [`crate::OccupancyError::VertexOutOfRange`], [`crate::OccupancyError::BadVertex`],
+    /// [`crate::OccupancyError::BadConfig`].
+    pub fn for_distance(
+        positions: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        config: &crate::Config,
+    ) -> Result<TriangleBvh, crate::OccupancyError> {
+        use crate::OccupancyError;
+        config.validate()?;
+        if triangles.is_empty() {
+            return Err(OccupancyError::NoTriangles);
+        }
+        let limit = crate::MAX_COORDINATE;
+        for (vertex, p) in positions.iter().enumerate() {
+            if let Some(&value) = p.iter().find(|x| !(x.is_finite() && x.abs() <= limit)) {
+                return Err(OccupancyError::BadVertex { vertex, value, limit });
+            }
+        }
+        let num_vertices = positions.len();
+        let mut corners = Vec::with_capacity(triangles.len());
+        for (triangle, t) in triangles.iter().enumerate() {
+            for &vertex in t {
+                if vertex as usize >= num_vertices {
+                    return Err(OccupancyError::VertexOutOfRange { triangle, vertex, num_vertices });
+                }
+            }
+            corners.push([positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]]);
+        }
+        Ok(crate::bvh::build_triangle_bvh(&corners, config.bvh_preset, config.max_leaf_size))
+    }
+
+    /// Closest point on the triangles to `q`: the same branch-and-bound and the same
+    /// (bit-identical) answer as [`crate::MeshOracle::closest_point`]. Uses and updates
+    /// `ws`'s previous-triangle hint.
+    ///
+    /// - `q`: query point, mesh frame, finite.
+    pub fn closest_point(&self, q: V3, ws: &mut crate::Workspace) -> ClosestPoint {
+        let (c, slot) = closest_point_slot(self, q, ws.last_slot, &mut ws.nodes_with_bound);
+        ws.last_slot = Some(slot);
+        c
+    }
+
+    /// Tight f64 bounding box `(min, max)` of the triangles, mesh frame.
+    pub fn bounding_box(&self) -> (V3, V3) {
+        (self.box_lo[0], self.box_hi[0])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::bvh::TriangleBvh;
+    use crate::{Config, MeshOracle, Workspace};
+
+    #[test]
+    fn distance_only_bvh_matches_the_oracle() {
+        let n = 9u32;
+        let mut p = Vec::new();
+        for i in 0..=n {
+            for j in 0..=n {
+                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+                p.push([x, y, 0.3 * (4.0 * x).sin() * y]);
+            }
+        }
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        let mut t = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let oracle = MeshOracle::new(&p, &t, &Config::default()).unwrap();
+        let bvh = TriangleBvh::for_distance(&p, &t, &Config::default()).unwrap();
+        assert_eq!(bvh.validate(), Ok(()));
+        assert_eq!(bvh.bounding_box(), oracle.bounding_box());
+        let (mut w1, mut w2) = (Workspace::new(), Workspace::new());
+        for k in 0..500 {
+            let f = k as f64;
+            let q = [(f * 0.37).sin() * 1.5, (f * 0.71).cos() * 1.5, (f * 0.13).sin()];
+            assert_eq!(bvh.closest_point(q, &mut w1), oracle.closest_point(q, &mut w2));
+        }
+        assert!(TriangleBvh::for_distance(&p, &[], &Config::default()).is_err());
+        assert!(TriangleBvh::for_distance(&[[f64::NAN, 0.0, 0.0]], &[[0, 0, 0]], &Config::default()).is_err());
+        assert!(TriangleBvh::for_distance(&p, &[[0, 1, 999]], &Config::default()).is_err());
+    }
+}

@@ -1,0 +1,146 @@
+//! Checkpoints: the whole [`TrainState`] in one `.npz` (readable with `numpy.load`),
+//! written atomically, restored bit-exactly.
+//!
+//! | array | shape, dtype | meaning |
+//! |---|---|---|
+//! | `format_version` | (1,) int64 | 1 |
+//! | `config_json` | (n,) uint8 | the [`TrainConfig`](crate::TrainConfig) as UTF-8 JSON |
+//! | `context_json` | (n,) uint8 | the caller's JSON (the CLI: input mesh, sampling, transform) |
+//! | `step` | (1,) uint64 | steps done |
+//! | `sites` | (K+B, 3) float64 | trainable then boundary sites, unit cube |
+//! | `labels` | (K+B,) uint8 | 1 = inside |
+//! | `adam_m`, `adam_v` | (K, 3) float64 | Adam moments |
+//! | `graph_offsets`, `graph_neighbors` | uint32 | Delaunay graph at the last refresh (CSR) |
+//! | `located_inside`, `located_closest` | (K,) uint8, (K, 3) float64 | sides and closest surface points at the last refresh |
+//! | `history` | (steps, 9) float64 | per-step statistics ([`StepStats::NAMES`](crate::StepStats::NAMES)) |
+//! | `data_fingerprint` | (1,) uint64 | fingerprint of the training samples |
+//!
+//! f64 values are stored bit for bit, so a resumed run repeats the uninterrupted one
+//! exactly.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use ndarray::{Array1, Array2};
+use ndarray_npy::{NpzReader, NpzWriter};
+
+use crate::error::TrainError;
+use crate::losses::{Located, SiteGraph};
+use crate::train::{StepStats, TrainState};
+
+/// The checkpoint format version.
+pub const FORMAT_VERSION: i64 = 1;
+
+fn rows(v: &[[f64; 3]]) -> Array2<f64> {
+    Array2::from_shape_vec((v.len(), 3), v.iter().flatten().copied().collect()).expect("n×3")
+}
+
+/// Writes `state` and the caller's `context_json` to `path` atomically (temporary file
+/// beside it, then rename).
+///
+/// # Errors
+/// [`TrainError::Checkpoint`] when the file cannot be written.
+pub fn write(path: &Path, state: &TrainState, context_json: &str) -> Result<(), TrainError> {
+    let fail = |message: String| TrainError::Checkpoint { path: path.display().to_string(), message };
+    let enc = |e: ndarray_npy::WriteNpzError| fail(format!("cannot encode ({e})"));
+    let mut w = NpzWriter::new(Cursor::new(Vec::new()));
+    let config = serde_json::to_string(&state.config).map_err(|e| fail(e.to_string()))?;
+    w.add_array("format_version", &Array1::from(vec![FORMAT_VERSION])).map_err(enc)?;
+    w.add_array("config_json", &Array1::from(config.into_bytes())).map_err(enc)?;
+    w.add_array("context_json", &Array1::from(context_json.as_bytes().to_vec())).map_err(enc)?;
+    w.add_array("step", &Array1::from(vec![state.step as u64])).map_err(enc)?;
+    w.add_array("sites", &rows(&state.sites)).map_err(enc)?;
+    w.add_array("labels", &Array1::from(state.labels.iter().map(|&b| b as u8).collect::<Vec<u8>>())).map_err(enc)?;
+    w.add_array("adam_m", &rows(&state.m)).map_err(enc)?;
+    w.add_array("adam_v", &rows(&state.v)).map_err(enc)?;
+    w.add_array("graph_offsets", &Array1::from(state.graph.offsets.clone())).map_err(enc)?;
+    w.add_array("graph_neighbors", &Array1::from(state.graph.neighbors.clone())).map_err(enc)?;
+    w.add_array("located_inside", &Array1::from(state.located.iter().map(|l| l.inside as u8).collect::<Vec<u8>>()))
+        .map_err(enc)?;
+    let closest: Vec<[f64; 3]> = state.located.iter().map(|l| l.closest).collect();
+    w.add_array("located_closest", &rows(&closest)).map_err(enc)?;
+    let hist: Vec<f64> = state.history.iter().flat_map(|s| s.to_row()).collect();
+    w.add_array("history", &Array2::from_shape_vec((state.history.len(), StepStats::COLUMNS), hist).expect("S×9"))
+        .map_err(enc)?;
+    w.add_array("data_fingerprint", &Array1::from(vec![state.data_fingerprint])).map_err(enc)?;
+    let bytes = w.finish().map_err(enc)?.into_inner();
+    mesh_io::atomic_write(path, |out| out.write_all(&bytes)).map_err(|e| fail(e.to_string()))
+}
+
+/// Reads a checkpoint: the state and the caller's context JSON.
+///
+/// # Errors
+/// [`TrainError::Checkpoint`] naming the missing or malformed array.
+pub fn read(path: &Path) -> Result<(TrainState, String), TrainError> {
+    let fail = |message: String| TrainError::Checkpoint { path: path.display().to_string(), message };
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read ({e})")))?;
+    let mut npz = NpzReader::new(Cursor::new(bytes)).map_err(|e| fail(format!("not an .npz archive ({e})")))?;
+    macro_rules! arr1 {
+        ($name:literal, $t:ty) => {
+            npz.by_name::<ndarray::OwnedRepr<$t>, ndarray::Ix1>($name)
+                .map_err(|e| fail(format!("array '{}': {e}", $name)))?
+                .to_vec()
+        };
+    }
+    macro_rules! arr2 {
+        ($name:literal) => {{
+            let a: Array2<f64> =
+                npz.by_name($name).map_err(|e| fail(format!("array '{}' (n×3 float64): {e}", $name)))?;
+            if a.ncols() != 3 && a.nrows() > 0 {
+                return Err(fail(format!("array '{}' has {} columns, expected 3", $name, a.ncols())));
+            }
+            a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect::<Vec<[f64; 3]>>()
+        }};
+    }
+    let version = arr1!("format_version", i64);
+    if version != [FORMAT_VERSION] {
+        return Err(fail(format!("format_version {version:?}; this build reads {FORMAT_VERSION}")));
+    }
+    let config_json =
+        String::from_utf8(arr1!("config_json", u8)).map_err(|_| fail("config_json is not UTF-8".into()))?;
+    let config = serde_json::from_str(&config_json).map_err(|e| fail(format!("config_json: {e}")))?;
+    let context = String::from_utf8(arr1!("context_json", u8)).map_err(|_| fail("context_json is not UTF-8".into()))?;
+    let step = arr1!("step", u64);
+    let sites = arr2!("sites");
+    let labels: Vec<bool> = arr1!("labels", u8).into_iter().map(|b| b != 0).collect();
+    let m = arr2!("adam_m");
+    let v = arr2!("adam_v");
+    let graph = SiteGraph { offsets: arr1!("graph_offsets", u32), neighbors: arr1!("graph_neighbors", u32) };
+    let inside = arr1!("located_inside", u8);
+    let closest = arr2!("located_closest");
+    let hist: Array2<f64> = npz.by_name("history").map_err(|e| fail(format!("array 'history': {e}")))?;
+    if hist.ncols() != StepStats::COLUMNS {
+        return Err(fail(format!("array 'history' has {} columns, expected {}", hist.ncols(), StepStats::COLUMNS)));
+    }
+    let history = hist.rows().into_iter().map(|r| StepStats::from_row(r.as_slice().unwrap_or(&r.to_vec()))).collect();
+    let fp = arr1!("data_fingerprint", u64);
+    if step.len() != 1 || fp.len() != 1 || inside.len() != closest.len() {
+        return Err(fail("arrays 'step', 'data_fingerprint' or 'located_*' have the wrong length".into()));
+    }
+    let n = sites.len();
+    let graph_ok = graph.offsets.is_empty()
+        || (graph.offsets.len() == n + 1
+            && graph.offsets.windows(2).all(|w| w[0] <= w[1])
+            && *graph.offsets.last().unwrap_or(&0) as usize == graph.neighbors.len()
+            && graph.neighbors.iter().all(|&j| (j as usize) < n));
+    if !graph_ok {
+        return Err(fail("the Delaunay graph arrays are inconsistent".into()));
+    }
+    if !sites.iter().chain(&m).chain(&v).flatten().all(|x| x.is_finite()) {
+        return Err(fail("non-finite sites or Adam moments".into()));
+    }
+    let located = inside.iter().zip(closest).map(|(&i, c)| Located { inside: i != 0, closest: c }).collect();
+    let state = TrainState {
+        config,
+        step: step[0] as usize,
+        sites,
+        labels,
+        m,
+        v,
+        graph,
+        located,
+        history,
+        data_fingerprint: fp[0],
+    };
+    Ok((state, context))
+}

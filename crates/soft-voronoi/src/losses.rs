@@ -1,0 +1,227 @@
+//! The training losses and their gradients with respect to the trainable sites.
+//!
+//! All gradients are accumulated in a fixed order (fixed-size chunks of samples or sites,
+//! reduced in chunk order) so a step's result is bit-identical for any thread count.
+
+use rayon::prelude::*;
+
+use crate::kernel::{self, Kernel, Scratch, SiteIndex};
+
+/// Samples per parallel chunk (fixed: the reduction order depends on it).
+pub const CHUNK: usize = 1024;
+
+/// Reconstruction loss (1/N) Σ_i |O(x_i) − V(x_i)| over a batch, and its gradient added
+/// (times `weight`) into `grad` for the first `grad.len()` sites (the trainable ones;
+/// later sites — fixed boundary sites — get none).
+///
+/// - `sites`, `labels`: all K + B sites; `index` built over `sites`.
+/// - `points`, `occupancy`: the batch (unit-cube frame) and its ground truth.
+pub fn reconstruction(
+    kernel: &Kernel,
+    index: &SiteIndex,
+    sites: &[[f64; 3]],
+    labels: &[bool],
+    points: &[[f64; 3]],
+    occupancy: &[bool],
+    weight: f64,
+    grad: &mut [[f64; 3]],
+) -> f64 {
+    let n = points.len().max(1) as f64;
+    let trainable = grad.len() as u32;
+    let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
+        .par_chunks(CHUNK)
+        .zip(occupancy.par_chunks(CHUNK))
+        .map(|(xs, os)| {
+            let mut s = Scratch::default();
+            let mut contributions = Vec::new();
+            let mut loss = 0.0;
+            for (&x, &o) in xs.iter().zip(os) {
+                let sign = if o { -1.0 } else { 1.0 };
+                let v = kernel::value_and_grad(kernel, index, sites, labels, x, &mut s, |k, g| {
+                    if k < trainable {
+                        contributions.push((k, [sign * g[0], sign * g[1], sign * g[2]]));
+                    }
+                });
+                loss += if o { 1.0 - v } else { v };
+            }
+            (loss, contributions)
+        })
+        .collect();
+    let mut loss = 0.0;
+    let f = weight / n;
+    for (l, contributions) in parts {
+        loss += l;
+        for (k, g) in contributions {
+            let acc = &mut grad[k as usize];
+            acc[0] += f * g[0];
+            acc[1] += f * g[1];
+            acc[2] += f * g[2];
+        }
+    }
+    loss / n
+}
+
+/// Bounds loss Σ_k Σ_c max(−p_kc, 0) + max(p_kc − 1, 0) over the trainable sites (the
+/// unit cube is the domain), with its gradient times `weight` added into `grad`.
+pub fn bounds(sites: &[[f64; 3]], weight: f64, grad: &mut [[f64; 3]]) -> f64 {
+    let mut loss = 0.0;
+    for (p, g) in sites.iter().zip(grad.iter_mut()) {
+        for c in 0..3 {
+            if p[c] < 0.0 {
+                loss -= p[c];
+                g[c] -= weight;
+            } else if p[c] > 1.0 {
+                loss += p[c] - 1.0;
+                g[c] += weight;
+            }
+        }
+    }
+    loss
+}
+
+/// Where a point lies relative to the target solid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Located {
+    /// Whether the point is inside the solid.
+    pub inside: bool,
+    /// A closest point on the solid's surface.
+    pub closest: [f64; 3],
+}
+
+/// The target shape, as needed by the signed-distance regulariser: inside test and
+/// closest surface point, in the unit-cube frame. Implemented for meshes
+/// ([`crate::MeshSolid`]) and analytic shapes (the sphere study).
+pub trait Solid: Sync {
+    /// Locates every point (any thread count; the result must not depend on it).
+    fn locate(&self, points: &[[f64; 3]]) -> Vec<Located>;
+}
+
+/// Signed-distance regulariser: (1/K) Σ_k dist(p_k, S_k) where S_k is the solid for an
+/// inside site and its complement for an outside site (0 when the site is on its side),
+/// with its gradient times `weight` added into `grad`. Sites are the trainable ones.
+pub fn signed_distance(
+    solid: &dyn Solid,
+    sites: &[[f64; 3]],
+    inside: &[bool],
+    weight: f64,
+    grad: &mut [[f64; 3]],
+) -> f64 {
+    signed_distance_cached(&solid.locate(sites), sites, inside, weight, grad)
+}
+
+/// [`signed_distance`] with the side and closest surface point of each site given
+/// (`located`, computed at a recent position of the sites: training refreshes them every
+/// `refresh_every` steps, during which a site moves at most a few learning rates). The
+/// distance and its gradient use the current positions.
+pub fn signed_distance_cached(
+    located: &[Located],
+    sites: &[[f64; 3]],
+    inside: &[bool],
+    weight: f64,
+    grad: &mut [[f64; 3]],
+) -> f64 {
+    let k = sites.len().max(1) as f64;
+    let mut loss = 0.0;
+    for (((p, &lab), loc), g) in sites.iter().zip(inside).zip(located).zip(grad.iter_mut()) {
+        if lab == loc.inside {
+            continue;
+        }
+        let d = kernel::distance(*p, loc.closest);
+        if d == 0.0 {
+            continue;
+        }
+        loss += d;
+        let f = weight / (k * d);
+        for c in 0..3 {
+            g[c] += f * (p[c] - loc.closest[c]);
+        }
+    }
+    loss / k
+}
+
+/// The Delaunay graph of all sites (trainable and boundary) in compressed rows, site
+/// indices as given.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SiteGraph {
+    /// #sites + 1 row offsets into `neighbors`.
+    pub offsets: Vec<u32>,
+    /// Neighbour site indices, sorted within each row.
+    pub neighbors: Vec<u32>,
+}
+
+impl SiteGraph {
+    /// The Delaunay graph of `sites` (exact, from delaunay3). Duplicate sites share one
+    /// Delaunay vertex; each copy gets that vertex's neighbours.
+    ///
+    /// # Errors
+    /// The triangulation's error (non-finite or all coplanar sites).
+    pub fn delaunay(sites: &[[f64; 3]]) -> Result<Self, delaunay3::DelaunayError> {
+        let dt = delaunay3::Delaunay3::new(sites)?;
+        let nv = dt.num_vertices();
+        let mut rows: Vec<Vec<u32>> = vec![Vec::new(); nv];
+        for e in dt.edges() {
+            let [a, b] = e.vertices;
+            if a as usize >= nv || b as usize >= nv {
+                continue;
+            }
+            rows[a as usize].push(b);
+            rows[b as usize].push(a);
+        }
+        let mut offsets = Vec::with_capacity(sites.len() + 1);
+        let mut neighbors = Vec::new();
+        offsets.push(0u32);
+        for i in 0..sites.len() {
+            let v = dt.vertex_of_input(i);
+            let mut row: Vec<u32> = rows[v as usize].iter().map(|&w| dt.input_of_vertex(w)).collect();
+            row.sort_unstable();
+            neighbors.extend(row);
+            offsets.push(neighbors.len() as u32);
+        }
+        Ok(SiteGraph { offsets, neighbors })
+    }
+
+    /// Neighbours of site `i`.
+    pub fn row(&self, i: usize) -> &[u32] {
+        &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// Number of sites the graph covers.
+    pub fn num_sites(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+}
+
+/// Centroidal regulariser (1/K) Σ_{i trainable} ‖(L p)_i‖² with the uniform graph
+/// Laplacian (L p)_i = p_i − mean_{j ∈ N(i)} p_j of `graph`, and its gradient times
+/// `weight` added into `grad` (trainable sites only).
+pub fn centroidal(graph: &SiteGraph, sites: &[[f64; 3]], weight: f64, grad: &mut [[f64; 3]]) -> f64 {
+    let trainable = grad.len();
+    let k = trainable.max(1) as f64;
+    let mut loss = 0.0;
+    for i in 0..trainable.min(graph.num_sites()) {
+        let row = graph.row(i);
+        if row.is_empty() {
+            continue;
+        }
+        let inv = 1.0 / row.len() as f64;
+        let mut r = sites[i];
+        for &j in row {
+            for c in 0..3 {
+                r[c] -= inv * sites[j as usize][c];
+            }
+        }
+        loss += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        let f = 2.0 * weight / k;
+        for c in 0..3 {
+            grad[i][c] += f * r[c];
+        }
+        for &j in row {
+            if (j as usize) < trainable {
+                for c in 0..3 {
+                    grad[j as usize][c] -= f * inv * r[c];
+                }
+            }
+        }
+    }
+    loss / k
+}
