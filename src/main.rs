@@ -13,6 +13,7 @@ mod cmd_fit;
 mod cmd_info;
 mod cmd_query;
 mod cmd_sample;
+mod cmd_study;
 mod output;
 
 use clap::{Parser, Subcommand};
@@ -41,6 +42,9 @@ struct Cli {
 enum Command {
     /// The main job: fit Voronoi sites to a mesh, write the crust, sites and report.
     Fit(cmd_fit::Args),
+    /// The sphere study: Voronoi sites against OccNet / DeepSDF MLPs, Hausdorff distance
+    /// against parameter count (results.csv, plot, table.md).
+    Study(cmd_study::Args),
     /// Print the topology report of a mesh (counts, boundary, manifoldness, genus, volume).
     Info(cmd_info::Args),
     /// Convert a mesh to GLB, glTF, OBJ or PLY (optionally normalised into the unit cube).
@@ -78,6 +82,7 @@ fn main() {
     };
     let result: Result<(), CliError> = match command {
         Command::Fit(args) => cmd_fit::run(args),
+        Command::Study(args) => cmd_study::run(args),
         Command::Info(args) => cmd_info::run(args),
         Command::Convert(args) => cmd_convert::run(args),
         Command::Sample(args) => cmd_sample::run(args),

@@ -30,7 +30,7 @@ def test_sites_file_reproduces_reported_misclassification(bin_path, tmp_path, me
     rng = np.random.default_rng(7)
     unit = rng.uniform(0.0, 1.0, (100_000, 3))
     world = unit @ T[:3, :3].T + T[:3, 3]
-    w = igl.fast_winding_number_for_meshes(np.asarray(v, np.float64), np.asarray(f, np.int64), world)
+    w = igl.winding_number(np.asarray(v, np.float64), np.asarray(f, np.int64), world)
     truth = np.abs(w) >= 0.5
     predicted = labels[cKDTree(sites).query(unit)[1]]
     ours = np.mean(predicted != truth)
@@ -40,9 +40,12 @@ def test_sites_file_reproduces_reported_misclassification(bin_path, tmp_path, me
 
     crust = trimesh.load(out, force="mesh")
     assert crust.is_watertight and crust.is_winding_consistent and crust.volume > 0
-    lo, hi = np.min(v, axis=0), np.max(v, axis=0)
-    diag = np.linalg.norm(hi - lo)
-    assert np.all(np.abs(crust.bounds[0] - lo) < 0.1 * diag) and np.all(np.abs(crust.bounds[1] - hi) < 0.1 * diag)
+    if mesh.name == "bunny.obj":
+        # In the input's frame (the soup's |w| >= 0.5 region is not near its triangles).
+        lo, hi = np.min(v, axis=0), np.max(v, axis=0)
+        diag = np.linalg.norm(hi - lo)
+        assert np.all(np.abs(crust.bounds[0] - lo) < 0.1 * diag)
+        assert np.all(np.abs(crust.bounds[1] - hi) < 0.1 * diag)
     assert_gltf_valid(out)
 
 

@@ -104,8 +104,8 @@ impl TrainConfig {
             boundary_sites: None,
             steps: 600,
             batch: 16384,
-            lr: 3e-5,
-            lr_final: 3e-7,
+            lr: Self::default_lr(num_sites),
+            lr_final: 0.01 * Self::default_lr(num_sites),
             beta: 10_000.0,
             beta_start: None,
             anneal_fraction: 0.5,
@@ -117,6 +117,12 @@ impl TrainConfig {
             adam: AdamParams::default(),
             seed: 0,
         }
+    }
+
+    /// The default learning rate: 3e-5 at 8,192 sites, scaled with the sites' expected
+    /// spacing on a surface (∝ K^−1/2), so fewer sites may move proportionally farther.
+    pub fn default_lr(num_sites: usize) -> f64 {
+        3e-5 * (8192.0 / num_sites.max(1) as f64).sqrt()
     }
 
     /// The seed paper's setting as this project reads it: uniform half-inside/half-outside
