@@ -223,8 +223,57 @@ fn summary_json_losses(state: &TrainState) -> serde_json::Value {
     })
 }
 
+/// The checked crust of `sites`, with its check and the number of jittered retries.
+///
+/// The crust is exact for the sites, but its Voronoi vertices are rounded to f64 in the
+/// output; where trained sites are nearly cospherical, distinct vertices can round onto
+/// each other and the exact checker rejects the mesh. Then the sites are moved by a seeded
+/// jitter far below their spacing (1e-9, then 1e-7 of the unit cube) and the crust is
+/// extracted again; `sites` is updated, so a sites file written from it reproduces the
+/// crust.
+///
+/// # Errors
+/// The crust's error, or the check's after two retries.
+pub(crate) fn checked_crust(
+    sites: &mut [[f64; 3]],
+    labels: &[bool],
+    seed: u64,
+) -> Result<(Crust, crust::check::CrustCheck, usize), CliError> {
+    let mut retries = 0;
+    loop {
+        let attempt = Crust::extract(sites, labels, &CrustConfig::default())
+            .map_err(|e| CliError::Failure(anyhow!("crust of the trained sites: {e}")))
+            .and_then(|c| match check_crust(&c.mesh) {
+                Ok(check) => Ok((c, check)),
+                Err(e) => Err(CliError::Failure(anyhow!("the crust failed its check ({e}); please report this"))),
+            });
+        match attempt {
+            Ok((c, check)) => return Ok((c, check, retries)),
+            Err(e) if retries >= 2 => return Err(e),
+            Err(_) => {
+                retries += 1;
+                let amplitude = if retries == 1 { 1e-9 } else { 1e-7 };
+                let mut rng = occupancy::sample::rng::ChunkRng::for_chunk(seed, 201, retries as u64);
+                for p in sites.iter_mut() {
+                    for x in p.iter_mut() {
+                        *x = (*x + amplitude * (2.0 * rng.uniform() - 1.0)).clamp(1e-9, 1.0 - 1e-9);
+                    }
+                }
+            }
+        }
+    }
+}
+
 pub fn run(args: Args) -> Result<(), CliError> {
     let t_all = Instant::now();
+    // Ctrl-C sets a flag; training checks it after every step and stops with a checkpoint.
+    // Installed first, so an early Ctrl-C also ends cleanly (before training nothing has
+    // been written and the run exits at the first step).
+    let interrupted = Arc::new(AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    }
     let out = outputs(&args)?;
     let mut timings = serde_json::Map::new();
     let mut lap = {
@@ -314,12 +363,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         None => Trainer::new(config.clone(), &data, &solid).map_err(bad)?,
     };
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        // A second handler cannot be installed (tests call run() once per process).
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
     let context_json = serde_json::to_string(&context).map_err(anyhow::Error::from)?;
     let bar = if args.quiet || args.json {
         indicatif::ProgressBar::hidden()
@@ -364,34 +407,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
 
     // Crust.
     let (mut sites, labels, num_projected) = trainer.final_sites();
-    // The crust is exact for the sites, but its Voronoi vertices are rounded to f64 in the
-    // output; where trained sites are nearly cospherical, distinct vertices can round onto
-    // each other and the exact checker rejects the mesh. Then the sites are moved by a
-    // seeded jitter far below their spacing (1e-9, then 1e-7 of the unit cube) and the
-    // crust is extracted again; the sites file stores the sites the crust was made from.
-    let mut crust_retries = 0;
-    let (crust, check) = loop {
-        let attempt = Crust::extract(&sites, &labels, &CrustConfig::default())
-            .map_err(|e| CliError::Failure(anyhow!("crust of the trained sites: {e}")))
-            .and_then(|c| match check_crust(&c.mesh) {
-                Ok(check) => Ok((c, check)),
-                Err(e) => Err(CliError::Failure(anyhow!("the crust failed its check ({e}); please report this"))),
-            });
-        match attempt {
-            Ok(ok) => break ok,
-            Err(e) if crust_retries >= 2 => return Err(e),
-            Err(_) => {
-                crust_retries += 1;
-                let amplitude = if crust_retries == 1 { 1e-9 } else { 1e-7 };
-                let mut rng = occupancy::sample::rng::ChunkRng::for_chunk(context.seed, 201, crust_retries as u64);
-                for p in &mut sites {
-                    for x in p.iter_mut() {
-                        *x = (*x + amplitude * (2.0 * rng.uniform() - 1.0)).clamp(1e-9, 1.0 - 1e-9);
-                    }
-                }
-            }
-        }
-    };
+    let (crust, check, crust_retries) = checked_crust(&mut sites, &labels, context.seed)?;
     let flip = transform.scale < 0.0;
     let crust_mesh = TriMesh {
         positions: crust.mesh.positions.iter().map(|&p| transform.from_unit(p)).collect(),

@@ -16,7 +16,6 @@ use std::time::Instant;
 
 use anyhow::anyhow;
 use baselines::{DecoderConfig, Mlp, Schedule};
-use crust::{check::check_crust, Crust, CrustConfig};
 use mesh_io::TriMesh;
 use occupancy::sample::rng::ChunkRng;
 use occupancy::sample::SurfaceSampler;
@@ -380,10 +379,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
             last = trainer.step().map_err(|e| CliError::Failure(e.into()))?.reconstruction;
         }
         let train_seconds = t.elapsed().as_secs_f64();
-        let (sites, labels, _) = trainer.final_sites();
-        let crust = Crust::extract(&sites, &labels, &CrustConfig::default())
-            .map_err(|e| CliError::Failure(anyhow!("crust of K = {k}: {e}")))?;
-        check_crust(&crust.mesh).map_err(|e| CliError::Failure(anyhow!("crust of K = {k} failed its check: {e}")))?;
+        let (mut sites, labels, _) = trainer.final_sites();
+        let (crust, _, _) = crate::cmd_fit::checked_crust(&mut sites, &labels, args.seed)
+            .map_err(|e| CliError::Failure(anyhow!("K = {k}: {e}")))?;
         let (lo, hi, chamfer, triangles, watertight) = measure(&crust.mesh, &budget, args.seed)?;
         mesh_io::write_mesh(&args.out.join(format!("meshes/voronoi_{k}.glb")), &crust.mesh)?;
         rows.push(Row {

@@ -187,3 +187,34 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
         assert_eq!(std::fs::read_dir(out_dir.path()).unwrap().count(), 0, "{args:?}: wrote something");
     }
 }
+
+/// A real Ctrl-C (SIGINT) during training: exit 130, a readable checkpoint, no crust.
+#[cfg(unix)]
+#[test]
+fn sigint_writes_a_checkpoint_and_exits_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("long.glb");
+    let mut child = bin()
+        .arg(root().join("assets/icosphere.obj"))
+        .arg("-o")
+        .arg(&out)
+        .args(["--quiet", "--sites", "512", "--steps", "1000000", "--samples", "50000", "--checkpoint-every", "1"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Interrupt once training is under way (the first checkpoint exists).
+    let ckpt = out.with_extension("ckpt.npz");
+    let start = std::time::Instant::now();
+    while !ckpt.exists() && start.elapsed().as_secs() < 300 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let ok = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success();
+    assert!(ok);
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(ckpt.exists() && !out.exists(), "{stderr}");
+    // The checkpoint loads: a resumed run continues (and is stopped again at once).
+    let o = fit(&root().join("assets/icosphere.obj"), &out, &["--resume", ckpt.to_str().unwrap(), "--stop-after", "1"]);
+    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+}
