@@ -59,10 +59,10 @@ def main():
     ap.add_argument("--sparse-repeats", type=int, default=20)
     args = ap.parse_args()
 
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "soft-voronoi", "--example", "step_timing"],
+    subprocess.run(["cargo", "build", "--release", "-q", "-p", "soft-voronoi", "--example", "kernel_step_timing"],
                    cwd=ROOT, check=True)
     target = os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target"))
-    exe = os.path.join(target, "release", "examples", "step_timing")
+    exe = os.path.join(target, "release", "examples", "kernel_step_timing")
     out = subprocess.run([exe, str(args.k), str(args.n), str(args.sparse_repeats), str(args.beta)],
                          check=True, capture_output=True, text=True).stdout
     sparse = json.loads(out)

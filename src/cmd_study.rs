@@ -226,51 +226,13 @@ pub fn sphere_hausdorff(mesh: &TriMesh, oracle: &MeshOracle, tol: f64) -> (f64, 
         let r = corners.iter().map(|&a| norm(s, a)).fold(0.0, f64::max) * RADIUS;
         (d, d + r)
     };
-    let phi = (1.0 + 5f64.sqrt()) / 2.0;
-    let v: Vec<[f64; 3]> = [
-        [-1.0, phi, 0.0],
-        [1.0, phi, 0.0],
-        [-1.0, -phi, 0.0],
-        [1.0, -phi, 0.0],
-        [0.0, -1.0, phi],
-        [0.0, 1.0, phi],
-        [0.0, -1.0, -phi],
-        [0.0, 1.0, -phi],
-        [phi, 0.0, -1.0],
-        [phi, 0.0, 1.0],
-        [-phi, 0.0, -1.0],
-        [-phi, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|&p| normalize(p))
-    .collect();
-    let faces: [[usize; 3]; 20] = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
+    // The starting patches: the icosahedron's faces (unit vectors, counter-clockwise).
+    let icosahedron = mesh_io::shapes::icosphere(0);
     let mut ws = Workspace::new();
     let mut lo2: f64 = 0.0;
     let mut heap = BinaryHeap::new();
-    for f in faces {
-        let corners = f.map(|i| v[i]);
+    for f in &icosahedron.triangles {
+        let corners = f.map(|i| icosahedron.positions[i as usize]);
         let (lo, ub) = eval(&corners, &mut ws);
         lo2 = lo2.max(lo);
         heap.push(Patch { ub, corners });

@@ -1,28 +1,9 @@
 //! The binary end to end: exit codes, the malformed-input corpus, and no partial output.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_voronoi-fit"))
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn shared_meshes() -> Vec<PathBuf> {
-    let dir =
-        std::env::var_os("VF_SHARED_MESHES").map(PathBuf::from).unwrap_or_else(|| root().join("../shared/meshes"));
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: the shared test meshes must sit beside the repository ({e})", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| mesh_io::Format::from_extension(p).is_some())
-        .collect();
-    v.sort();
-    assert!(v.len() >= 8);
-    v
-}
+mod common;
+use common::{bin, root, shared_meshes};
 
 #[test]
 fn malformed_corpus_exits_2_names_the_element_and_writes_nothing() {

@@ -4,26 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_voronoi-fit"))
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn shared_meshes() -> Vec<PathBuf> {
-    let dir =
-        std::env::var_os("VF_SHARED_MESHES").map(PathBuf::from).unwrap_or_else(|| root().join("../shared/meshes"));
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: the shared test meshes must sit beside the repository ({e})", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| mesh_io::Format::from_extension(p).is_some())
-        .collect();
-    v.sort();
-    assert!(v.len() >= 8);
-    v
-}
+mod common;
+use common::{bin, root, shared_meshes};
 
 /// Settings small enough for a test run.
 const QUICK: [&str; 8] = ["--sites", "1024", "--steps", "40", "--samples", "100000", "--eval-samples", "50000"];
@@ -194,7 +176,7 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
 fn sigint_writes_a_checkpoint_and_exits_130() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("long.glb");
-    let mut child = bin()
+    let child = bin()
         .arg(root().join("assets/icosphere.obj"))
         .arg("-o")
         .arg(&out)

@@ -284,15 +284,7 @@ pub fn hausdorff_certified(
     b: &TriMesh,
     opts: &CertifiedOptions,
 ) -> Result<HausdorffInterval, MetricsError> {
-    let t0 = Instant::now();
-    opts.validate()?;
-    let (da, db) = rayon::join(
-        || DistanceMesh::with_preset(a, "A", BvhPreset::VeryFast),
-        || DistanceMesh::with_preset(b, "B", BvhPreset::VeryFast),
-    );
-    let mut r = certify(&da?, &db?, Sides::Both, opts)?;
-    r.seconds = t0.elapsed().as_secs_f64();
-    Ok(r)
+    certified(a, b, Sides::Both, opts)
 }
 
 /// Certified interval of the one-sided distance `h(A, B) = max_{x ∈ A} d(x, B)`.
@@ -304,13 +296,23 @@ pub fn directed_hausdorff_certified(
     b: &TriMesh,
     opts: &CertifiedOptions,
 ) -> Result<HausdorffInterval, MetricsError> {
+    certified(a, b, Sides::AToB, opts)
+}
+
+/// Prepares both meshes in parallel and certifies `sides`, timing the whole call.
+fn certified(
+    a: &TriMesh,
+    b: &TriMesh,
+    sides: Sides,
+    opts: &CertifiedOptions,
+) -> Result<HausdorffInterval, MetricsError> {
     let t0 = Instant::now();
     opts.validate()?;
     let (da, db) = rayon::join(
         || DistanceMesh::with_preset(a, "A", BvhPreset::VeryFast),
         || DistanceMesh::with_preset(b, "B", BvhPreset::VeryFast),
     );
-    let mut r = certify(&da?, &db?, Sides::AToB, opts)?;
+    let mut r = certify(&da?, &db?, sides, opts)?;
     r.seconds = t0.elapsed().as_secs_f64();
     Ok(r)
 }

@@ -114,8 +114,15 @@ pub struct Scratch {
     weights: Vec<f64>,
 }
 
-/// Soft occupancy V(x) from candidate (site, distance) pairs and their minimum distance.
-fn value_from_candidates(kernel: &Kernel, labels: &[bool], cands: &[(u32, f64)], d_min: f64, w: &mut Vec<f64>) -> f64 {
+/// Soft occupancy V(x) from candidate (site, distance) pairs and their minimum distance,
+/// with the normaliser z = Σ w (the unnormalised weights are left in `w`).
+fn value_from_candidates(
+    kernel: &Kernel,
+    labels: &[bool],
+    cands: &[(u32, f64)],
+    d_min: f64,
+    w: &mut Vec<f64>,
+) -> (f64, f64) {
     w.clear();
     let mut z = 0.0;
     let mut num = 0.0;
@@ -128,7 +135,7 @@ fn value_from_candidates(kernel: &Kernel, labels: &[bool], cands: &[(u32, f64)],
         }
     }
     // z ≥ 1: the nearest site contributes exp(0).
-    num / z
+    (num / z, z)
 }
 
 /// V(x) for one point.
@@ -141,7 +148,7 @@ pub fn value(
     s: &mut Scratch,
 ) -> f64 {
     let d_min = index.candidates(sites, x, kernel.window(), &mut s.candidates);
-    value_from_candidates(kernel, labels, &s.candidates, d_min, &mut s.weights)
+    value_from_candidates(kernel, labels, &s.candidates, d_min, &mut s.weights).0
 }
 
 /// V(x) and ∂V/∂p_k for the candidate sites k (every other site has a gradient below
@@ -156,11 +163,10 @@ pub fn value_and_grad(
     mut grad: impl FnMut(u32, [f64; 3]),
 ) -> f64 {
     let d_min = index.candidates(sites, x, kernel.window(), &mut s.candidates);
-    let v = value_from_candidates(kernel, labels, &s.candidates, d_min, &mut s.weights);
+    let (v, z) = value_from_candidates(kernel, labels, &s.candidates, d_min, &mut s.weights);
     if s.candidates.len() < 2 {
         return v;
     }
-    let z: f64 = s.weights.iter().sum();
     for (&(k, d), &e) in s.candidates.iter().zip(&s.weights) {
         let lam = if labels[k as usize] { 1.0 } else { 0.0 };
         let coef = (e / z) * (lam - v);

@@ -2,7 +2,7 @@
 //! gradient over the batch) and prints one JSON line; `benches/compare_soft_voronoi.py`
 //! runs it beside a dense numpy step of the same size.
 //!
-//! `cargo run --release -p soft-voronoi --example step_timing -- [K] [N] [REPEATS] [BETA]`
+//! `cargo run --release -p soft-voronoi --example kernel_step_timing -- [K] [N] [REPEATS] [BETA]`
 //! Sites uniform in the unit cube labelled by a ball of radius 0.35, samples uniform.
 
 use std::time::Instant;
