@@ -3,15 +3,20 @@
 numpy implementation of the same step, in one run.
 
     python benches/compare_mlp.py [--width 256] [--depth 5] [--batch 65536] [--steps 5]
-                                  [--threads 2] [--no-torch] [--no-numpy]
+                                  [--threads 2] [--repeats 3] [--no-torch] [--no-numpy]
 
 The crate is timed by its example (`cargo run --release -p baselines --example
 step_timing`, built first; honours CARGO_TARGET_DIR). Each implementation does one
-untimed warm-up step, then `--steps` timed steps on the same batch; reported: seconds per
-step and steps/s, and the ratio crate / other in steps per second (> 1: the crate is
-faster). PyTorch runs with `torch.set_num_threads(--threads)`; numpy uses its BLAS's
+untimed warm-up step, then `--steps` timed steps on the same batch, in `--repeats` rounds
+that time every implementation once each; reported: the median seconds per step and
+steps/s, and the ratio crate / other in steps per second (> 1: the crate is faster) with
+its range over the rounds. PyTorch runs with `torch.set_num_threads(--threads)`; numpy uses its BLAS's
 threads (set OPENBLAS_NUM_THREADS to pin them). PyTorch is skipped with a note when it
-cannot be imported (the PyPI wheel is large; install `torch` into the bench venv).
+cannot be imported. PyPI's Linux wheel is the CUDA build and pulls in the nvidia-* wheels
+(5.4 GB in all); it runs on the CPU without a GPU. Install it into a venv of its own:
+
+    python3 -m venv target/bench-torch && target/bench-torch/bin/pip install torch==2.15.0 numpy
+    target/bench-torch/bin/python benches/compare_mlp.py
 """
 import argparse
 import json
@@ -108,7 +113,7 @@ def torch_step_fn(width, depth, batch, threads):
         loss = lossf(net(x)[:, 0], y)
         loss.backward()
         opt.step()
-        return float(loss)
+        return loss.item()
 
     return step, torch.__version__
 
@@ -128,6 +133,7 @@ def main():
     ap.add_argument("--batch", type=int, default=65536)
     ap.add_argument("--steps", type=int, default=5)
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--no-torch", action="store_true")
     ap.add_argument("--no-numpy", action="store_true")
     a = ap.parse_args()
@@ -135,25 +141,36 @@ def main():
     print(f"MLP 3→{a.width}×{a.depth}→1 ({params:,} parameters), batch {a.batch:,}, float32, BCE + Adam; "
           f"{a.steps} timed steps after one warm-up; {os.cpu_count()} CPUs")
     subprocess.run(["cargo", "build", "--release", "-q", "-p", "baselines", "--example", "step_timing"], cwd=ROOT, check=True)
-    s_ours, rec = ours(a.width, a.depth, a.batch, a.steps)
-    print(f"  baselines (Rust, {rec['threads']} rayon threads): {s_ours:.3f} s/step = {1 / s_ours:.3f} steps/s")
-    rows = []
+    impls = {}
     if not a.no_torch:
         try:
             step, ver = torch_step_fn(a.width, a.depth, a.batch, a.threads)
         except Exception as e:  # ImportError or a wheel whose native libraries are missing
             print(f"  PyTorch: not available ({type(e).__name__}: {e}); skipped")
         else:
-            s = time_steps(step, a.steps)
-            print(f"  PyTorch {ver} (CPU, {a.threads} threads): {s:.3f} s/step = {1 / s:.3f} steps/s")
-            rows.append(("PyTorch", s))
+            impls[f"PyTorch {ver} (CPU, {a.threads} threads)"] = step
     if not a.no_numpy:
-        s = time_steps(numpy_step_fn(a.width, a.depth, a.batch), a.steps)
-        print(f"  numpy {np.__version__} (same step by hand, BLAS threads as configured): {s:.3f} s/step = {1 / s:.3f} steps/s")
-        rows.append(("numpy", s))
-    for name, s in rows:
-        print(f"ratio baselines / {name} (steps per second): {s / s_ours:.2f}")
-
+        impls[f"numpy {np.__version__} (same step by hand, BLAS threads as configured)"] = numpy_step_fn(a.width, a.depth, a.batch)
+    # Interleaved repeats: every implementation is timed once per round, so a change in the
+    # machine's load affects all of them alike.
+    times = {"baselines": []} | {name: [] for name in impls}
+    for r in range(a.repeats):
+        s_ours, rec = ours(a.width, a.depth, a.batch, a.steps)
+        times["baselines"].append(s_ours)
+        line = [f"baselines {1 / s_ours:.3f}"]
+        for name, step in impls.items():
+            times[name].append(time_steps(step, a.steps))
+            line.append(f"{name.split(' (')[0]} {1 / times[name][-1]:.3f}")
+        print(f"  round {r + 1}: steps/s " + ", ".join(line))
+    med = {name: float(np.median(ts)) for name, ts in times.items()}
+    print(f"median over {a.repeats} round(s):")
+    print(f"  baselines (Rust, {rec['threads']} rayon threads): {med['baselines']:.3f} s/step = {1 / med['baselines']:.3f} steps/s")
+    for name in impls:
+        print(f"  {name}: {med[name]:.3f} s/step = {1 / med[name]:.3f} steps/s")
+    for name in impls:
+        per_round = [t / o for t, o in zip(times[name], times["baselines"])]
+        print(f"ratio baselines / {name.split(' (')[0]} (steps per second): {med[name] / med['baselines']:.2f} "
+              f"(rounds: {min(per_round):.2f}–{max(per_round):.2f})")
 
 if __name__ == "__main__":
     main()

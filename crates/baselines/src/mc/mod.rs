@@ -22,17 +22,28 @@
 //! cells sharing it agree: the result is crack-free. Chaining the segments gives closed
 //! polygons on the cube's surface. When there are two polygons around two regions of one
 //! sign that the trilinear interpolant joins through the cell's inside (the "tunnel"
-//! subcases of cases 4, 6, 7, 10, 12, 13), they are joined by a tube; otherwise each
-//! polygon is a fan (from a corner whose diagonals all leave the cell's faces, else around
-//! a new vertex at its centroid). The interior test is exact: a sweep of the cell by planes
-//! along axis 2 whose bilinear slices change topology only at ≤ 6 heights (see
-//! `connected_in_cube`). [`Ambiguity::SeparateAbove`] and [`Ambiguity::JoinAbove`] are
-//! fixed face rules without interior test (the classic 256-case table is `SeparateAbove`).
+//! subcases of cases 4, 6, 7, 10, 12, 13), they are joined by a tube. The interior test is
+//! exact: a sweep of the cell by planes along axis 2 whose bilinear slices change topology
+//! only at ≤ 6 heights (see `connected_in_cube`). [`Ambiguity::SeparateAbove`] and
+//! [`Ambiguity::JoinAbove`] are fixed face rules without interior test (the classic 256-case
+//! table is `SeparateAbove`).
 //!
-//! Against skimage: `SeparateAbove` gives exactly `method="lorensen"`'s polygons in every
-//! cell; the default gives `method="lewiner"`'s on smooth fields, and on noise differs in
-//! about 1% of cells, where a sampled trilinear interpolant agrees with this crate
-//! (`tests/reference/test_baselines.py`).
+//! # Triangulation
+//!
+//! Where a cell's polygons are those of the classic 256-case table (every face separating
+//! its above corners and no tube: always with `SeparateAbove`, and in every unambiguous cell
+//! and most ambiguous ones with the default), the cell's triangles are the table's (see
+//! `classic_triangles`; the polygons of all 256 cases are checked against the table in this
+//! module's tests). Elsewhere each polygon is a fan from a corner whose diagonals all leave
+//! the cell's faces, else around a new vertex at its centroid, and a tube is a ring of new
+//! vertices with two strips.
+//!
+//! Against skimage (`tests/reference/test_baselines.py`): `SeparateAbove` gives exactly
+//! `method="lorensen"`'s triangles, on noise too. The default gives exactly
+//! `method="lewiner"`'s triangles on smooth fields and in every unambiguous cell; in
+//! ambiguous cells Lewiner's tables triangulate their own way, and in about 1% of noise
+//! cells their topology differs, where a sampled trilinear interpolant agrees with this
+//! crate.
 //!
 //! # Output
 //!
@@ -222,59 +233,7 @@ pub fn marching_cubes(grid: ArrayView3<f64>, opts: &McOptions) -> Result<TriMesh
                 if mask == 0 || mask == 255 {
                     continue;
                 }
-                let above = |c: usize| mask & (1 << c) != 0;
-                // Face segments: succ[entry edge] = exit edge.
-                let mut succ = [usize::MAX; 12];
-                // Ambiguous faces whose above corners are joined.
-                let mut joined_faces = 0u8;
-                let mut ambiguous_faces = 0u8;
-                for (fi, face) in FACES.iter().enumerate() {
-                    // Crossings in counter-clockwise order; `true` = entering the above region.
-                    let mut cross = [(0usize, false); 4];
-                    let mut n = 0;
-                    for q in 0..4 {
-                        let (a, b) = (face[q], face[(q + 1) % 4]);
-                        if above(a) != above(b) {
-                            cross[n] = (edge_of(a, b), above(b));
-                            n += 1;
-                        }
-                    }
-                    match n {
-                        0 => {}
-                        2 => {
-                            let (e, x) = if cross[0].1 { (cross[0].0, cross[1].0) } else { (cross[1].0, cross[0].0) };
-                            succ[e] = x;
-                        }
-                        _ => {
-                            // Rotate so the sequence is entry, exit, entry, exit.
-                            let r = if cross[0].1 { 0 } else { 1 };
-                            let (e1, x1, e2, x2) =
-                                (cross[r].0, cross[(r + 1) % 4].0, cross[(r + 2) % 4].0, cross[(r + 3) % 4].0);
-                            let join = match opts.ambiguity {
-                                Ambiguity::SeparateAbove => false,
-                                Ambiguity::JoinAbove => true,
-                                Ambiguity::AsymptoticDecider => {
-                                    let (a, b, c, d) = (v[face[0]], v[face[1]], v[face[2]], v[face[3]]);
-                                    // Above pair (a, c) or (b, d); joined iff the saddle is above.
-                                    if a > 0.0 {
-                                        a * c - b * d > 0.0
-                                    } else {
-                                        b * d - a * c > 0.0
-                                    }
-                                }
-                            };
-                            ambiguous_faces |= 1 << fi;
-                            if join {
-                                joined_faces |= 1 << fi;
-                                succ[e1] = x2;
-                                succ[e2] = x1;
-                            } else {
-                                succ[e1] = x1;
-                                succ[e2] = x2;
-                            }
-                        }
-                    }
-                }
+                let (succ, joined_faces, ambiguous_faces) = face_segments(&v, mask, opts.ambiguity);
                 // Vertices of the crossed edges.
                 for e in 0..12 {
                     local_vertex[e] = u32::MAX;
@@ -350,7 +309,16 @@ pub fn marching_cubes(grid: ArrayView3<f64>, opts: &McOptions) -> Result<TriMesh
                     && cycles[1].len() >= 3
                     && joined_inside(&v, mask, joined_faces, ambiguous_faces);
                 fan.clear();
-                if tube {
+                // Where the cell's polygons are the classic table's (every face separating its
+                // above corners, no tube), its triangulation is the classic table's too.
+                let classic = match opts.ambiguity {
+                    Ambiguity::SeparateAbove => true,
+                    Ambiguity::AsymptoticDecider => joined_faces == 0 && !tube,
+                    Ambiguity::JoinAbove => false,
+                };
+                if classic && classic_triangles(mask, &local_vertex, &mut fan) {
+                    // done
+                } else if tube {
                     let (c1, c2) = cycles.split_at(1);
                     tube_triangles(&c1[0], &c2[0], &mut fan, &mut positions);
                 } else {
@@ -372,6 +340,136 @@ pub fn marching_cubes(grid: ArrayView3<f64>, opts: &McOptions) -> Result<TriMesh
         }
     }
     Ok(TriMesh { positions, triangles })
+}
+
+/// Corner of this module (bit 0 → axis 0, bit 1 → axis 1, bit 2 → axis 2) for each corner of
+/// the classic table's numbering, (x, y, z) = 0 (0,0,0), 1 (1,0,0), 2 (1,1,0), 3 (0,1,0), then
+/// the same at z = 1. skimage puts the table's x along array axis 2 and z along axis 0 (found
+/// by trying the 48 symmetries of the cube against skimage on all 254 cases; only this one
+/// gives its triangles in every case).
+const CLASSIC_CORNER: [usize; 8] = [0, 4, 6, 2, 1, 5, 7, 3];
+
+/// This module's local edge for each edge of the classic table's numbering: 0–3 the cycle of
+/// corners 0-1-2-3, 4–7 the cycle 4-5-6-7, 8–11 the edges from corner c to c + 4.
+const CLASSIC_EDGE: [usize; 12] = {
+    let mut out = [0usize; 12];
+    let mut e = 0;
+    while e < 12 {
+        let (p, q) = if e < 4 {
+            (e, (e + 1) % 4)
+        } else if e < 8 {
+            (e, 4 + (e - 3) % 4)
+        } else {
+            (e - 8, e - 4)
+        };
+        out[e] = edge_of(CLASSIC_CORNER[p], CLASSIC_CORNER[q]);
+        e += 1;
+    }
+    out
+};
+
+/// The classic 256-case table's triangles for a cell whose above corners are `mask` (this
+/// module's corner bits), as local vertices (`local_vertex[e]` for local edge `e`), oriented
+/// like this module's polygons for [`Inside::Above`]. Returns false (and leaves `out` alone)
+/// if a table edge has no vertex, which cannot happen when the cell's crossed edges are the
+/// table's.
+///
+/// The table is `marching_cubes::tables::TRI_TABLE` (Paul Bourke's listing of the Lorensen–
+/// Cline table, the one scikit-image's `method="lorensen"` uses and whose triangulations
+/// its `"lewiner"` tables share in the unambiguous cases): it is data that fixes which
+/// diagonals split each polygon, and using it makes the triangles, not only the polygons,
+/// those of skimage. Indexed by the above corners (skimage's convention; Bourke's page
+/// states it for the below ones, the table being the same), its triangles are clockwise
+/// seen from the below side, so they are reversed here.
+fn classic_triangles(mask: u32, local_vertex: &[u32; 12], out: &mut Vec<[u32; 3]>) -> bool {
+    let mut index = 0usize;
+    for (b, &c) in CLASSIC_CORNER.iter().enumerate() {
+        if mask & (1 << c) != 0 {
+            index |= 1 << b;
+        }
+    }
+    let row = &marching_cubes::tables::TRI_TABLE[index];
+    let start = out.len();
+    for t in row.chunks_exact(3) {
+        if t[0] < 0 {
+            break;
+        }
+        let v = |k: usize| usize::try_from(t[k]).ok().and_then(|e| CLASSIC_EDGE.get(e)).map(|&e| local_vertex[e]);
+        match (v(0), v(1), v(2)) {
+            (Some(a), Some(b), Some(c)) if a != u32::MAX && b != u32::MAX && c != u32::MAX => {
+                out.push(if CLASSIC_REVERSED { [a, c, b] } else { [a, b, c] })
+            }
+            _ => {
+                out.truncate(start);
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether the classic table's triangles are reversed to match [`Inside::Above`] here.
+const CLASSIC_REVERSED: bool = false;
+
+/// The segments the cell's faces contribute (`succ[entry edge] = exit edge`, `usize::MAX`
+/// for an edge without crossing), the faces with diagonal above and below corners (bits as
+/// in [`FACES`]), and those of them whose above corners were joined. `v`: corner values minus
+/// the level; `mask`: above corners.
+fn face_segments(v: &[f64; 8], mask: u32, ambiguity: Ambiguity) -> ([usize; 12], u8, u8) {
+    let above = |c: usize| mask & (1 << c) != 0;
+    // Face segments: succ[entry edge] = exit edge.
+    let mut succ = [usize::MAX; 12];
+    // Ambiguous faces whose above corners are joined.
+    let mut joined_faces = 0u8;
+    let mut ambiguous_faces = 0u8;
+    for (fi, face) in FACES.iter().enumerate() {
+        // Crossings in counter-clockwise order; `true` = entering the above region.
+        let mut cross = [(0usize, false); 4];
+        let mut n = 0;
+        for q in 0..4 {
+            let (a, b) = (face[q], face[(q + 1) % 4]);
+            if above(a) != above(b) {
+                cross[n] = (edge_of(a, b), above(b));
+                n += 1;
+            }
+        }
+        match n {
+            0 => {}
+            2 => {
+                let (e, x) = if cross[0].1 { (cross[0].0, cross[1].0) } else { (cross[1].0, cross[0].0) };
+                succ[e] = x;
+            }
+            _ => {
+                // Rotate so the sequence is entry, exit, entry, exit.
+                let r = if cross[0].1 { 0 } else { 1 };
+                let (e1, x1, e2, x2) =
+                    (cross[r].0, cross[(r + 1) % 4].0, cross[(r + 2) % 4].0, cross[(r + 3) % 4].0);
+                let join = match ambiguity {
+                    Ambiguity::SeparateAbove => false,
+                    Ambiguity::JoinAbove => true,
+                    Ambiguity::AsymptoticDecider => {
+                        let (a, b, c, d) = (v[face[0]], v[face[1]], v[face[2]], v[face[3]]);
+                        // Above pair (a, c) or (b, d); joined iff the saddle is above.
+                        if a > 0.0 {
+                            a * c - b * d > 0.0
+                        } else {
+                            b * d - a * c > 0.0
+                        }
+                    }
+                };
+                ambiguous_faces |= 1 << fi;
+                if join {
+                    joined_faces |= 1 << fi;
+                    succ[e1] = x2;
+                    succ[e2] = x1;
+                } else {
+                    succ[e1] = x1;
+                    succ[e2] = x2;
+                }
+            }
+        }
+    }
+    (succ, joined_faces, ambiguous_faces)
 }
 
 /// The 12 cube edges as corner pairs.
@@ -662,4 +760,44 @@ pub fn extract_mesh<T: Real>(decoder: &Mlp<T>, res: usize) -> Result<TriMesh> {
         DecoderKind::DeepSdf => Inside::Below,
     };
     marching_cubes(grid.view(), &McOptions { spacing: [h; 3], inside, ..Default::default() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeSet;
+
+    /// For all 256 cases: the classic table's triangles (vertex = local edge) have exactly the
+    /// directed boundary of the polygons `face_segments` builds with every face separating its
+    /// above corners, so the table agrees with this module's faces and orientation, and every
+    /// interior diagonal is used by exactly two triangles and lies off the cube's faces.
+    #[test]
+    fn classic_table_triangulates_the_separate_above_polygons() {
+        let ids: [u32; 12] = std::array::from_fn(|e| e as u32);
+        for mask in 1u32..255 {
+            let v: [f64; 8] = std::array::from_fn(|c| if mask & (1 << c) != 0 { 1.0 } else { -1.0 });
+            let (succ, joined, _) = face_segments(&v, mask, Ambiguity::SeparateAbove);
+            assert_eq!(joined, 0);
+            let polygon: BTreeSet<(u32, u32)> =
+                (0..12).filter(|&e| succ[e] != usize::MAX).map(|e| (e as u32, succ[e] as u32)).collect();
+            let mut local = [u32::MAX; 12];
+            for e in 0..12 {
+                if succ[e] != usize::MAX {
+                    local[e] = ids[e];
+                }
+            }
+            let mut tris = Vec::new();
+            assert!(classic_triangles(mask, &local, &mut tris), "case {mask:#010b}: table edge without crossing");
+            let directed: Vec<(u32, u32)> =
+                tris.iter().flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]).collect();
+            let set: BTreeSet<(u32, u32)> = directed.iter().copied().collect();
+            assert_eq!(set.len(), directed.len(), "case {mask:#010b}: a directed edge used twice");
+            let boundary: BTreeSet<(u32, u32)> = set.iter().copied().filter(|&(a, b)| !set.contains(&(b, a))).collect();
+            assert_eq!(boundary, polygon, "case {mask:#010b}");
+            let faces = |e: u32| edge_face_mask(e as usize);
+            for &(a, b) in set.difference(&boundary) {
+                assert_eq!(faces(a) & faces(b), 0, "case {mask:#010b}: diagonal {a}-{b} lies in a cube face");
+            }
+        }
+    }
 }
