@@ -18,10 +18,11 @@ type; grids are float32-representable, as skimage converts to float32):
 
 Results:
 - `Ambiguity::SeparateAbove` ("separate") vs `method="lorensen"`: identical triangle sets on
-  every grid, uniform noise (all 254 cases) and values exactly on the level included.
+  every grid: SDFs, uniform noise (all 254 cases), a ReLU decoder's values, and values
+  exactly on the level.
 - The default (asymptotic decider on faces, exact interior test) vs the default
   `method="lewiner"`: identical triangle sets on smooth fields (sphere, torus), and on noise
-  in every cell without an ambiguous face or body diagonal. In ambiguous cells Lewiner's
+  and decoder grids in every cell without an ambiguous face or body diagonal. In ambiguous cells Lewiner's
   tables triangulate differently (some with a centre vertex), a few cells in 10,000 have
   other face polygons, and about 0.8% another interior (tube vs two discs), where the
   crate's choice is checked against the sampled trilinear interpolant
@@ -239,6 +240,38 @@ def test_lorensen_noise_identical(mc_bin, tmp_path, n, seed):
         assert r["differing"] == [], f"{len(r['differing'])} of {r['cells']} cells differ: {r['differing'][:5]}"
         diff, total = triangle_difference(r["skimage"], r["rust"])
         assert sum(diff.values()) == 0, f"{sum(diff.values())} of {total} triangles differ"
+
+
+def relu_decoder_field(n, seed, width=64, depth=3):
+    """An OccNet-shaped decoder's values on the n³ grid of [-1, 1]³ (float32): a ReLU MLP
+    3→width×depth→1 with PyTorch's default uniform initialisation, shifted so that half the
+    grid is above 0. Piecewise linear, like every ReLU decoder's logit field."""
+    rng = np.random.default_rng(seed)
+    x = np.linspace(-1.0, 1.0, n)
+    h = np.stack(np.meshgrid(x, x, x, indexing="ij"), axis=-1).reshape(-1, 3)
+    dims = [3] + [width] * depth
+    for i, o in zip(dims[:-1], dims[1:]):
+        b = 1 / np.sqrt(i)
+        h = np.maximum(h @ rng.uniform(-b, b, (i, o)) + rng.uniform(-b, b, o), 0.0)
+    b = 1 / np.sqrt(width)
+    f = (h @ rng.uniform(-b, b, (width, 1)) + rng.uniform(-b, b, 1)).reshape(n, n, n).astype(np.float32)
+    return f - np.median(f)
+
+
+@pytest.mark.parametrize("seed", [7, 8])
+def test_decoder_grid(mc_bin, tmp_path, seed):
+    """The issue's case, a grid of decoder values (64³): `lorensen` triangle for triangle;
+    `lewiner` the same except in a few ambiguous cells."""
+    g = relu_decoder_field(64, seed)
+    r = compare(mc_bin, tmp_path, g, 0.0, "lorensen", "separate")
+    diff, total = triangle_difference(r["skimage"], r["rust"])
+    assert total > 10_000 and sum(diff.values()) == 0, f"{sum(diff.values())} of {total} triangles differ"
+    r = compare(mc_bin, tmp_path, g, 0.0, "lewiner", "decider")
+    masks = cell_masks(g)
+    ts, tr = (cell_triangle_sets(*m, g.shape) for m in (r["skimage"], r["rust"]))
+    tri_differ = [c for c in set(ts) | set(tr) if ts.get(c) != tr.get(c)]
+    assert all(ambiguous(int(masks[c])) for c in tri_differ), tri_differ[:5]
+    assert len(tri_differ) < 1e-3 * len(ts)
 
 
 def trilinear_components(vals, s=48):
