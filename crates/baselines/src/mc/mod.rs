@@ -317,7 +317,7 @@ pub fn marching_cubes(grid: ArrayView3<f64>, opts: &McOptions) -> Result<TriMesh
                     Ambiguity::JoinAbove => false,
                 };
                 if classic && classic_triangles(mask, &local_vertex, &mut fan) {
-                    // done
+                    // The table's triangles are in `fan`.
                 } else if tube {
                     let (c1, c2) = cycles.split_at(1);
                     tube_triangles(&c1[0], &c2[0], &mut fan, &mut positions);
@@ -378,9 +378,9 @@ const CLASSIC_EDGE: [usize; 12] = {
 /// Cline table, the one scikit-image's `method="lorensen"` uses and whose triangulations
 /// its `"lewiner"` tables share in the unambiguous cases): it is data that fixes which
 /// diagonals split each polygon, and using it makes the triangles, not only the polygons,
-/// those of skimage. Indexed by the above corners (skimage's convention; Bourke's page
-/// states it for the below ones, the table being the same), its triangles are clockwise
-/// seen from the below side, so they are reversed here.
+/// those of skimage. It is indexed, as skimage does, by the corners above the level (so an
+/// ambiguous face separates its above corners), and with skimage's axis order its triangles
+/// already turn the way this module's polygons do (the unit test below checks both).
 fn classic_triangles(mask: u32, local_vertex: &[u32; 12], out: &mut Vec<[u32; 3]>) -> bool {
     let mut index = 0usize;
     for (b, &c) in CLASSIC_CORNER.iter().enumerate() {
@@ -397,7 +397,7 @@ fn classic_triangles(mask: u32, local_vertex: &[u32; 12], out: &mut Vec<[u32; 3]
         let v = |k: usize| usize::try_from(t[k]).ok().and_then(|e| CLASSIC_EDGE.get(e)).map(|&e| local_vertex[e]);
         match (v(0), v(1), v(2)) {
             (Some(a), Some(b), Some(c)) if a != u32::MAX && b != u32::MAX && c != u32::MAX => {
-                out.push(if CLASSIC_REVERSED { [a, c, b] } else { [a, b, c] })
+                out.push([a, b, c])
             }
             _ => {
                 out.truncate(start);
@@ -407,9 +407,6 @@ fn classic_triangles(mask: u32, local_vertex: &[u32; 12], out: &mut Vec<[u32; 3]
     }
     true
 }
-
-/// Whether the classic table's triangles are reversed to match [`Inside::Above`] here.
-const CLASSIC_REVERSED: bool = false;
 
 /// The segments the cell's faces contribute (`succ[entry edge] = exit edge`, `usize::MAX`
 /// for an edge without crossing), the faces with diagonal above and below corners (bits as
