@@ -396,9 +396,7 @@ fn classic_triangles(mask: u32, local_vertex: &[u32; 12], out: &mut Vec<[u32; 3]
         }
         let v = |k: usize| usize::try_from(t[k]).ok().and_then(|e| CLASSIC_EDGE.get(e)).map(|&e| local_vertex[e]);
         match (v(0), v(1), v(2)) {
-            (Some(a), Some(b), Some(c)) if a != u32::MAX && b != u32::MAX && c != u32::MAX => {
-                out.push([a, b, c])
-            }
+            (Some(a), Some(b), Some(c)) if a != u32::MAX && b != u32::MAX && c != u32::MAX => out.push([a, b, c]),
             _ => {
                 out.truncate(start);
                 return false;
@@ -439,8 +437,7 @@ fn face_segments(v: &[f64; 8], mask: u32, ambiguity: Ambiguity) -> ([usize; 12],
             _ => {
                 // Rotate so the sequence is entry, exit, entry, exit.
                 let r = if cross[0].1 { 0 } else { 1 };
-                let (e1, x1, e2, x2) =
-                    (cross[r].0, cross[(r + 1) % 4].0, cross[(r + 2) % 4].0, cross[(r + 3) % 4].0);
+                let (e1, x1, e2, x2) = (cross[r].0, cross[(r + 1) % 4].0, cross[(r + 2) % 4].0, cross[(r + 3) % 4].0);
                 let join = match ambiguity {
                     Ambiguity::SeparateAbove => false,
                     Ambiguity::JoinAbove => true,
