@@ -1,21 +1,19 @@
 //! `.npy` / `.npz` input and output for the CLI, through ndarray-npy.
 //!
-//! Outputs are assembled in memory and written with [`mesh_io::atomic_write`], so a failure
-//! leaves no partial file. Inputs are checked for shape, dtype and finiteness, and errors
-//! name the file and how to fix it.
-#![allow(dead_code)] // helpers used by subcommands as they land
+//! Outputs are assembled in memory and written with [`mesh_io::atomic_write`] (`.npz`:
+//! [`vf_common::npz::NpzOut`]), so a failure leaves no partial file. Inputs are checked for
+//! shape, dtype and finiteness, and errors name the file and how to fix it.
 
 use std::io::Cursor;
 use std::path::Path;
 
-use anyhow::anyhow;
 use ndarray::{Array1, Array2, ArrayBase, Data, Dimension};
 use ndarray_npy::{ReadNpyExt, WritableElement, WriteNpyExt};
 
 use crate::cli_error::CliError;
 
 fn bad(path: &Path, msg: impl std::fmt::Display) -> CliError {
-    CliError::BadInput(anyhow!("{}: {msg}", path.display()))
+    CliError::input(format!("{}: {msg}", path.display()))
 }
 
 /// Read an (n, 3) array of points, f64 or f32, from a `.npy` file.
@@ -54,11 +52,6 @@ pub fn read_points_npy(path: &Path) -> Result<Vec<[f64; 3]>, CliError> {
     Ok(out)
 }
 
-/// (n, 3) array from points.
-pub fn points_array(points: &[[f64; 3]]) -> Array2<f64> {
-    Array2::from_shape_vec((points.len(), 3), points.iter().flatten().copied().collect()).expect("n×3 elements")
-}
-
 /// (n, k) array from rows of any element type.
 pub fn rows_array<T: Copy, const K: usize>(rows: &[[T; K]]) -> Array2<T> {
     Array2::from_shape_vec((rows.len(), K), rows.iter().flatten().copied().collect()).expect("n×k elements")
@@ -79,36 +72,8 @@ where
     let mut buf = Vec::new();
     array
         .write_npy(&mut buf)
-        .map_err(|e| CliError::Failure(anyhow!("{}: cannot encode the array ({e})", path.display())))?;
-    mesh_io::atomic_write(path, |w| w.write_all(&buf)).map_err(CliError::from)
+        .map_err(|e| CliError::failure(format!("{}: cannot encode the array ({e})", path.display())))?;
+    Ok(mesh_io::atomic_write(path, |w| w.write_all(&buf))?)
 }
 
-/// Builds an uncompressed `.npz` in memory; [`Npz::write`] puts it on disk atomically.
-pub struct Npz {
-    writer: ndarray_npy::NpzWriter<Cursor<Vec<u8>>>,
-}
-
-impl Npz {
-    pub fn new() -> Self {
-        Npz { writer: ndarray_npy::NpzWriter::new(Cursor::new(Vec::new())) }
-    }
-
-    /// Add an array under `name` (readable as `numpy.load(path)[name]`).
-    pub fn add<A, S, D>(&mut self, name: &str, array: &ArrayBase<S, D>) -> Result<(), CliError>
-    where
-        A: WritableElement,
-        S: Data<Elem = A>,
-        D: Dimension,
-    {
-        self.writer.add_array(name, array).map_err(|e| CliError::Failure(anyhow!("cannot encode array {name} ({e})")))
-    }
-
-    pub fn write(self, path: &Path) -> Result<(), CliError> {
-        let bytes = self
-            .writer
-            .finish()
-            .map_err(|e| CliError::Failure(anyhow!("{}: cannot finish the npz ({e})", path.display())))?
-            .into_inner();
-        mesh_io::atomic_write(path, |w| w.write_all(&bytes)).map_err(CliError::from)
-    }
-}
+pub use vf_common::npz::NpzOut as Npz;

@@ -1,9 +1,10 @@
-//! `voronoi-fit convert MESH -o OUT [--normalize]`: read any supported mesh, write
-//! GLB / glTF / OBJ / PLY (chosen by the output extension), atomically.
+//! `voronoi-fit convert MESH -o OUT [--normalize] [--weld-tolerance T]`: read any supported
+//! mesh, write GLB / glTF / OBJ / PLY (chosen by the output extension), atomically.
 
 use std::path::PathBuf;
 
 use anyhow::anyhow;
+use mesh_io::OutputFormat;
 
 use crate::cli_error::CliError;
 
@@ -20,21 +21,33 @@ pub struct Args {
     /// Empty space left on each side of the unit cube by --normalize, in unit-cube lengths.
     #[arg(long, default_value_t = 0.05, requires = "normalize")]
     pub margin: f64,
+    /// Merge vertices at most this fraction of the bounding-box diagonal apart before
+    /// writing (closes the hairline cracks of CAD exports; 1e-6 is typical), dropping the
+    /// triangles that collapse. 0, or between 1e-15 and 1e-2.
+    #[arg(long, value_name = "FRACTION", value_parser = mesh_io::weld::parse_tolerance)]
+    pub weld_tolerance: Option<f64>,
 }
 
 pub fn run(args: Args) -> Result<(), CliError> {
-    if mesh_io::Format::from_extension(&args.output).is_none()
-        || args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("stl") || e.eq_ignore_ascii_case("off"))
-    {
-        return Err(CliError::BadInput(anyhow!(
-            "{}: the output extension names no format this program writes. Use .glb, .gltf, .obj or .ply.",
-            args.output.display()
-        )));
-    }
+    // Everything about the output is checked before the input is read.
+    let format = OutputFormat::from_path(&args.output)?;
     if !(0.0..0.5).contains(&args.margin) {
         return Err(CliError::BadInput(anyhow!("--margin {} is outside [0, 0.5).", args.margin)));
     }
+    mesh_io::check_output_location(&args.output)?;
     let mut mesh = mesh_io::read_mesh(&args.mesh)?;
+    if let Some(t) = args.weld_tolerance {
+        let (welded, w) = mesh_io::weld_tolerance(&mesh, t);
+        mesh = welded;
+        crate::output::out!(
+            "welded at {:e} × diagonal ({:.3e}): {} → {} vertices, {} degenerate triangles dropped",
+            w.relative_tolerance,
+            w.absolute_tolerance,
+            w.vertices_before,
+            w.vertices_after,
+            w.degenerate_triangles_dropped
+        );
+    }
     if args.normalize {
         let t = mesh_io::UnitCubeTransform::of_mesh(&mesh, args.margin).ok_or_else(|| {
             CliError::BadInput(anyhow!(
@@ -43,6 +56,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             ))
         })?;
         mesh = t.mesh_to_unit(&mesh);
+    } else if format.stores_f32() {
+        mesh_io::check_f32_resolution(&mesh, &args.mesh)?;
     }
     mesh_io::write_mesh(&args.output, &mesh)?;
     Ok(())

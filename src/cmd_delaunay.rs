@@ -4,10 +4,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::anyhow;
 
 use crate::arrays::{read_points_npy, rows_array, write_npy};
-use crate::cli_error::CliError;
+use crate::cli_error::{CliError, InFile};
 use delaunay3::Delaunay3;
 
 #[derive(clap::Args)]
@@ -32,17 +31,17 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("npy")) {
-        return Err(CliError::BadInput(anyhow!("{}: the output must be a .npy file.", args.output.display())));
+        return Err(CliError::input(format!("{}: the output must be a .npy file.", args.output.display())));
     }
     let points = read_points_npy(&args.points)?;
     let t0 = Instant::now();
-    let dt = Delaunay3::new(&points).map_err(|e| CliError::BadInput(anyhow!("{}: {e}.", args.points.display())))?;
+    let dt = Delaunay3::new(&points).in_file(&args.points)?;
     let build_s = t0.elapsed().as_secs_f64();
     let mut validate_s = None;
     if args.validate {
         let t1 = Instant::now();
         dt.validate().map_err(|e| {
-            CliError::Failure(anyhow!(
+            CliError::failure(format!(
                 "{}: internal error, please report it with the input file: {e}",
                 args.points.display()
             ))

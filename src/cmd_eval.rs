@@ -4,7 +4,6 @@
 
 use std::path::PathBuf;
 
-use anyhow::anyhow;
 use metrics::{CertifiedOptions, EvalOptions, MetricsError, SurfaceOptions};
 
 use crate::cli_error::CliError;
@@ -49,9 +48,9 @@ fn to_cli(e: MetricsError, args: &Args) -> CliError {
         MetricsError::Empty { mesh }
         | MetricsError::BadVertex { mesh, .. }
         | MetricsError::VertexOutOfRange { mesh, .. }
-        | MetricsError::ZeroArea { mesh, .. } => CliError::BadInput(anyhow!("{}: {e}", which(mesh))),
-        MetricsError::BadOption(_) => CliError::BadInput(anyhow!("{e}")),
-        MetricsError::Occupancy(_) => CliError::Failure(anyhow!("{e}")),
+        | MetricsError::ZeroArea { mesh, .. } => CliError::input(format!("{}: {e}", which(mesh))),
+        MetricsError::BadOption(_) => CliError::input(&e),
+        MetricsError::Occupancy(_) => CliError::failure(&e),
     }
 }
 

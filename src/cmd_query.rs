@@ -4,10 +4,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use anyhow::anyhow;
 
-use crate::arrays::{points_array, read_points_npy, vec_array, Npz};
-use crate::cli_error::CliError;
+use crate::arrays::{read_points_npy, vec_array, Npz};
+use crate::cli_error::{CliError, InFile};
 use occupancy::{Config, MeshOracle, WindingMode};
 
 #[derive(clap::Args)]
@@ -33,38 +32,34 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("npz")) {
-        return Err(CliError::BadInput(anyhow!("{}: the output must be a .npz file.", args.output.display())));
+        return Err(CliError::input(format!("{}: the output must be a .npz file.", args.output.display())));
     }
     let mesh = mesh_io::read_mesh(&args.mesh)?;
     let queries = read_points_npy(&args.points)?;
     let config = Config::default();
     let t0 = Instant::now();
-    let oracle = MeshOracle::from_mesh(&mesh, &config)
-        .map_err(|e| CliError::BadInput(anyhow!("{}: {e}", args.mesh.display())))?;
+    let oracle = MeshOracle::from_mesh(&mesh, &config).in_file(&args.mesh)?;
     let build_s = t0.elapsed().as_secs_f64();
     let mode = if args.exact { WindingMode::Exact } else { WindingMode::Fast };
     let t1 = Instant::now();
     let c1 = process_cpu_seconds();
-    let winding = oracle
-        .winding_numbers(&queries, mode)
-        .map_err(|e| CliError::BadInput(anyhow!("{}: {e}", args.points.display())))?;
+    let winding = oracle.winding_numbers(&queries, mode).in_file(&args.points)?;
     let winding_s = t1.elapsed().as_secs_f64();
     let winding_cpu_s = process_cpu_seconds().zip(c1).map(|(b, a)| b - a);
     let t2 = Instant::now();
     let c2 = process_cpu_seconds();
-    let closest =
-        oracle.closest_points(&queries).map_err(|e| CliError::BadInput(anyhow!("{}: {e}", args.points.display())))?;
+    let closest = oracle.closest_points(&queries).in_file(&args.points)?;
     let distance_s = t2.elapsed().as_secs_f64();
     let distance_cpu_s = process_cpu_seconds().zip(c2).map(|(b, a)| b - a);
 
-    let threshold = config.occupancy_threshold;
-    let occupancy: Vec<u8> = winding.iter().map(|&w| (w >= threshold) as u8).collect();
+    // The workspace's one inside rule (|w| ≥ 0.5), as for sampling, training and IoU.
+    let occupancy: Vec<u8> = winding.iter().map(|&w| config.is_inside_winding(w) as u8).collect();
     let sdf: Vec<f64> = winding
         .iter()
         .zip(&closest)
         .map(|(&w, c)| {
             let d = c.squared_distance.sqrt();
-            if w >= threshold {
+            if config.is_inside_winding(w) {
                 -d
             } else {
                 d
@@ -79,7 +74,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     npz.add("winding", &vec_array(&winding))?;
     npz.add("occupancy", &vec_array(&occupancy))?;
     npz.add("sdf", &vec_array(&sdf))?;
-    npz.add("closest", &points_array(&points))?;
+    npz.add_rows("closest", &points)?;
     npz.add("squared_distance", &vec_array(&sqd))?;
     npz.add("triangle", &vec_array(&tri))?;
     add_config(&mut npz, &config, args.exact)?;

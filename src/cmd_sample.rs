@@ -4,11 +4,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::anyhow;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::arrays::{points_array, vec_array, Npz};
-use crate::cli_error::CliError;
+use crate::arrays::{vec_array, Npz};
+use crate::cli_error::{CliError, InFile};
 use crate::cmd_query::add_config;
 use occupancy::sample::{near_surface, uniform_in_box, SurfaceSampler};
 use occupancy::{Config, MeshOracle, WindingMode};
@@ -48,30 +47,25 @@ pub struct Args {
     pub output: PathBuf,
 }
 
-fn bad(msg: String) -> CliError {
-    CliError::BadInput(anyhow!(msg))
-}
-
 pub fn run(args: Args) -> Result<(), CliError> {
     if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("npz")) {
-        return Err(bad(format!("{}: the output must be a .npz file.", args.output.display())));
+        return Err(CliError::input(format!("{}: the output must be a .npz file.", args.output.display())));
     }
     if args.num_samples == 0 {
-        return Err(bad("-n must be at least 1.".into()));
+        return Err(CliError::input("-n must be at least 1."));
     }
     if !(0.0..=1.0).contains(&args.uniform_fraction) {
-        return Err(bad(format!("--uniform-fraction {} is outside [0, 1].", args.uniform_fraction)));
+        return Err(CliError::input(format!("--uniform-fraction {} is outside [0, 1].", args.uniform_fraction)));
     }
     if !(args.padding.is_finite() && args.padding >= 0.0) {
-        return Err(bad(format!("--padding {} must be finite and >= 0.", args.padding)));
+        return Err(CliError::input(format!("--padding {} must be finite and >= 0.", args.padding)));
     }
     if let Some(s) = args.near_sigma.iter().find(|s| !(s.is_finite() && **s >= 0.0)) {
-        return Err(bad(format!("--near-sigma {s} must be finite and >= 0.")));
+        return Err(CliError::input(format!("--near-sigma {s} must be finite and >= 0.")));
     }
     let mesh = mesh_io::read_mesh(&args.mesh)?;
-    let mesh_err = |e: occupancy::OccupancyError| bad(format!("{}: {e}", args.mesh.display()));
     let config = Config::default();
-    let oracle = MeshOracle::from_mesh(&mesh, &config).map_err(mesh_err)?;
+    let oracle = MeshOracle::from_mesh(&mesh, &config).in_file(&args.mesh)?;
 
     let n = args.num_samples;
     let num_uniform = ((n as f64) * args.uniform_fraction).round() as usize;
@@ -85,11 +79,11 @@ pub fn run(args: Args) -> Result<(), CliError> {
         glo[k] -= pad;
         ghi[k] += pad;
     }
-    let mut points = uniform_in_box(glo, ghi, num_uniform, args.seed).map_err(mesh_err)?;
+    let mut points = uniform_in_box(glo, ghi, num_uniform, args.seed).in_file(&args.mesh)?;
     if num_near > 0 {
-        let sampler = SurfaceSampler::from_mesh(&mesh).map_err(mesh_err)?;
+        let sampler = SurfaceSampler::from_mesh(&mesh).in_file(&args.mesh)?;
         let sigmas: Vec<f64> = args.near_sigma.iter().map(|s| s * diag).collect();
-        points.extend(near_surface(&sampler, num_near, &sigmas, args.seed).map_err(mesh_err)?);
+        points.extend(near_surface(&sampler, num_near, &sigmas, args.seed).in_file(&args.mesh)?);
     }
 
     let mode = if args.exact { WindingMode::Exact } else { WindingMode::Fast };
@@ -109,7 +103,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mut sdf = Vec::with_capacity(n);
     for chunk in points.chunks(PROGRESS_CHUNK) {
         let batch =
-            oracle.query(chunk, mode).map_err(|e| CliError::Failure(anyhow!("sampled an invalid point: {e}")))?;
+            oracle.query(chunk, mode).map_err(|e| CliError::failure(format!("sampled an invalid point: {e}")))?;
         winding.extend(batch.winding);
         occupancy.extend(batch.occupancy);
         sdf.extend(batch.sdf);
@@ -118,7 +112,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     bar.finish_and_clear();
 
     let mut npz = Npz::new();
-    npz.add("points", &points_array(&points))?;
+    npz.add_rows("points", &points)?;
     npz.add("winding", &vec_array(&winding))?;
     npz.add("occupancy", &vec_array(&occupancy))?;
     npz.add("sdf", &vec_array(&sdf))?;

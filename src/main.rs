@@ -92,7 +92,10 @@ fn main() {
         Command::Eval(args) => cmd_eval::run(args),
     };
     if let Err(e) = result {
-        eprintln!("error: {e}");
+        match &e {
+            CliError::Interrupted(m) => eprintln!("{m}"),
+            _ => eprintln!("error: {e}"),
+        }
         std::process::exit(e.exit_code());
     }
 }

@@ -24,7 +24,6 @@
 pub mod error;
 pub mod mc;
 pub mod mlp;
-mod rng;
 pub mod scalar;
 pub mod train;
 
@@ -32,6 +31,7 @@ pub use error::{BaselineError, Result};
 pub use mc::{extract_mesh, marching_cubes, Ambiguity, Inside, McOptions, DEFAULT_GRID_RES};
 pub use mlp::{Decoder, DecoderConfig, DecoderKind, Mlp};
 pub use scalar::Real;
+pub use vf_common::AdamParams;
 pub use train::{
-    loss_and_grad, train, AdamConfig, GradEngine, Schedule, StepRecord, TrainConfig, TrainReport, Trainer, TrainingData,
+    loss_and_grad, train, GradEngine, Schedule, StepRecord, TrainConfig, TrainReport, Trainer, TrainingData,
 };

@@ -13,7 +13,7 @@ use ndarray::{s, Array3, ArrayView2, ArrayViewMut2};
 use rayon::prelude::*;
 
 use crate::error::{config_err, BaselineError, Result};
-use crate::rng::Rng;
+use vf_common::rng::{SplitMix64, Stream};
 use crate::scalar::Real;
 
 /// Which decoder and loss.
@@ -143,7 +143,7 @@ impl<T: Real> Mlp<T> {
             layers.push(Layer { n_in, n_out, w: off });
             off += n_in * n_out + n_out;
         }
-        let mut rng = Rng::new(seed, 0x1417_5EED);
+        let mut rng = SplitMix64::new(seed, Stream::MlpInit);
         let mut params = Vec::with_capacity(off);
         for layer in &layers {
             let bound = 1.0 / (layer.n_in as f64).sqrt();

@@ -19,7 +19,8 @@ use rayon::prelude::*;
 
 use crate::error::{config_err, BaselineError, Result};
 use crate::mlp::{DecoderKind, Mlp, Workspace};
-use crate::rng::Rng;
+use vf_common::rng::{SplitMix64, Stream};
+use vf_common::AdamParams;
 use crate::scalar::Real;
 
 /// Training samples: points with occupancy (OccNet) and/or signed-distance (DeepSDF)
@@ -86,19 +87,6 @@ pub enum Schedule {
     },
 }
 
-/// Adam hyper-parameters (PyTorch's defaults).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AdamConfig {
-    pub beta1: f64,
-    pub beta2: f64,
-    pub eps: f64,
-}
-
-impl Default for AdamConfig {
-    fn default() -> Self {
-        AdamConfig { beta1: 0.9, beta2: 0.999, eps: 1e-8 }
-    }
-}
 
 /// How to train.
 #[derive(Clone, Debug, PartialEq)]
@@ -113,7 +101,7 @@ pub struct TrainConfig {
     pub seed: u64,
     /// Rows per parallel chunk (fixes the summation order; 4,096 by default).
     pub chunk_rows: usize,
-    pub adam: AdamConfig,
+    pub adam: AdamParams,
 }
 
 impl Default for TrainConfig {
@@ -125,7 +113,7 @@ impl Default for TrainConfig {
             schedule: Schedule::Constant,
             seed: 0,
             chunk_rows: 4096,
-            adam: AdamConfig::default(),
+            adam: AdamParams::default(),
         }
     }
 }
@@ -284,25 +272,18 @@ struct Adam<T: Real> {
     m: Vec<T>,
     v: Vec<T>,
     t: u64,
-    cfg: AdamConfig,
+    cfg: AdamParams,
 }
 
 impl<T: Real> Adam<T> {
-    fn new(n: usize, cfg: AdamConfig) -> Self {
+    fn new(n: usize, cfg: AdamParams) -> Self {
         Adam { m: vec![T::zero(); n], v: vec![T::zero(); n], t: 0, cfg }
     }
 
-    /// PyTorch's update: `p −= lr/(1−β1ᵗ) · m / (√v/√(1−β2ᵗ) + ε)`.
+    /// One step of Adam (`vf_common::adam`, PyTorch's form), in parallel blocks.
     fn update(&mut self, params: &mut [T], grad: &[T], lr: f64) {
         self.t += 1;
-        let c = self.cfg;
-        let bc1 = 1.0 - c.beta1.powi(self.t.min(i32::MAX as u64) as i32);
-        let bc2 = 1.0 - c.beta2.powi(self.t.min(i32::MAX as u64) as i32);
-        let (b1, b2) = (T::of(c.beta1), T::of(c.beta2));
-        let (ob1, ob2) = (T::of(1.0 - c.beta1), T::of(1.0 - c.beta2));
-        let step = T::of(lr / bc1);
-        let inv_sqrt_bc2 = T::of(1.0 / bc2.sqrt());
-        let eps = T::of(c.eps);
+        let step = self.cfg.at::<T>(self.t, lr);
         const BLOCK: usize = 8192;
         params
             .par_chunks_mut(BLOCK)
@@ -310,11 +291,7 @@ impl<T: Real> Adam<T> {
             .zip(self.v.par_chunks_mut(BLOCK))
             .zip(grad.par_chunks(BLOCK))
             .for_each(|(((p, m), v), g)| {
-                for i in 0..p.len() {
-                    m[i] = b1 * m[i] + ob1 * g[i];
-                    v[i] = b2 * v[i] + ob2 * g[i] * g[i];
-                    p[i] = p[i] - step * m[i] / (v[i].sqrt() * inv_sqrt_bc2 + eps);
-                }
+                step.apply(p, g, m, v);
             });
     }
 }
@@ -328,7 +305,7 @@ pub struct Trainer<T: Real> {
     batch: usize,
     perm: Vec<u32>,
     pos: usize,
-    rng: Rng,
+    rng: SplitMix64,
     step: usize,
 }
 
@@ -348,7 +325,7 @@ impl<T: Real> Trainer<T> {
             batch,
             perm: (0..n_data as u32).collect(),
             pos: 0,
-            rng: Rng::new(config.seed, 0x0BA7_C4E5),
+            rng: SplitMix64::new(config.seed, Stream::MlpBatch),
             step: 0,
         };
         if batch < n_data {

@@ -1,8 +1,8 @@
 //! The exact checker of the crust's guarantees.
 //!
-//! Combinatorics come from [`mesh_io::TopologyReport`]; self-intersection is decided with
-//! Shewchuk's exact orientation predicates (robust), so the verdict does not depend on
-//! rounding.
+//! Combinatorics come from [`mesh_io::TopologyReport`]; degeneracy and intersections are
+//! decided with Shewchuk's exact orientation predicates (robust), so the verdict does not
+//! depend on rounding.
 
 use mesh_io::{TopologyReport, TriMesh};
 use robust::{orient2d, orient3d, Coord, Coord3D};
@@ -15,40 +15,99 @@ pub struct CrustCheck {
     pub report: TopologyReport,
     /// Triangle pairs whose bounding boxes overlap and that share no vertex position.
     pub num_pairs_tested: usize,
+    /// Triangle pairs that share one or two vertex positions (an edge), tested for meeting
+    /// anywhere else.
+    pub num_adjacent_pairs_tested: usize,
 }
 
 /// Check a crust: closed (every edge in exactly two triangles, opposite orientations),
-/// vertex-manifold, positive volume (unless empty), and no two triangles that share no
-/// vertex position intersect (exact test). Triangles meeting at a split vertex share its
-/// position, so they count as adjacent.
+/// vertex-manifold, positive volume (unless empty), no degenerate triangle (a repeated
+/// vertex or exactly collinear corners), and no two triangles meet where they should not
+/// (exact tests): triangles that share no vertex position are disjoint, triangles that
+/// share one vertex position meet only there, and triangles that share an edge meet only
+/// along it (no fold). Triangles meeting at a split vertex share its position, so they
+/// count as adjacent.
 ///
 /// # Errors
 /// A message naming the first guarantee that fails.
 pub fn check_crust(mesh: &TriMesh) -> Result<CrustCheck, String> {
+    find_defects(mesh, true).map_err(|d| d.message)
+}
+
+/// Why a mesh failed [`check_crust`]: the message, and the triangles at fault where the
+/// failure is geometric (degenerate triangles and both triangles of every meeting pair, or
+/// only the first pair when stopping at the first).
+#[derive(Clone, Debug)]
+pub(crate) struct Defects {
+    pub message: String,
+    /// Triangle indices at fault (empty for a combinatorial failure).
+    pub triangles: Vec<u32>,
+}
+
+/// [`check_crust`], reporting the triangles at fault; with `stop_at_first` false, every
+/// degenerate triangle and every meeting pair is listed.
+pub(crate) fn find_defects(mesh: &TriMesh, stop_at_first: bool) -> Result<CrustCheck, Defects> {
     let report = TopologyReport::of(mesh);
+    let fail = |message: String| Defects { message, triangles: Vec::new() };
     if mesh.triangles.is_empty() {
-        return Ok(CrustCheck { report, num_pairs_tested: 0 });
+        return Ok(CrustCheck { report, num_pairs_tested: 0, num_adjacent_pairs_tested: 0 });
     }
     if !report.is_closed {
-        return Err(format!(
+        return Err(fail(format!(
             "not closed: {} boundary and {} non-manifold edges",
             report.num_boundary_edges, report.num_non_manifold_edges
-        ));
+        )));
     }
     if !report.is_orientation_consistent {
-        return Err("inconsistent orientation: an edge is used twice in the same direction".into());
+        return Err(fail("inconsistent orientation: an edge is used twice in the same direction".into()));
     }
     if report.num_non_manifold_vertices > 0 {
-        return Err(format!("{} non-manifold vertices", report.num_non_manifold_vertices));
+        return Err(fail(format!("{} non-manifold vertices", report.num_non_manifold_vertices)));
+    }
+    let degenerate: Vec<u32> = (0..mesh.triangles.len() as u32).filter(|&t| is_degenerate(mesh, t as usize)).collect();
+    if let Some(&first) = degenerate.first() {
+        return Err(Defects {
+            message: format!(
+                "{} degenerate triangles (a repeated vertex or collinear corners), the first {first}",
+                degenerate.len()
+            ),
+            triangles: degenerate,
+        });
     }
     if !(report.signed_volume > 0.0) {
-        return Err(format!("volume {} is not positive", report.signed_volume));
+        return Err(fail(format!("volume {} is not positive", report.signed_volume)));
     }
-    let (num_pairs_tested, hit) = self_intersections(mesh, true);
-    if let Some((a, b)) = hit {
-        return Err(format!("triangles {a} and {b} intersect (exact test)"));
+    let scan = scan(mesh, stop_at_first, true);
+    if let Some(&(a, b)) = scan.hits.first() {
+        let what = if shared_positions(mesh, a, b) == 0 { "intersect" } else { "overlap beyond their shared vertices" };
+        return Err(Defects {
+            message: format!("triangles {a} and {b} {what} (exact test)"),
+            triangles: scan.hits.iter().flat_map(|&(a, b)| [a as u32, b as u32]).collect(),
+        });
     }
-    Ok(CrustCheck { report, num_pairs_tested })
+    Ok(CrustCheck { report, num_pairs_tested: scan.disjoint_tested, num_adjacent_pairs_tested: scan.adjacent_tested })
+}
+
+/// Whether triangle `t` has a repeated vertex or exactly collinear corners (the topology
+/// report's definition of degenerate).
+fn is_degenerate(mesh: &TriMesh, t: usize) -> bool {
+    let [i, j, k] = mesh.triangles[t];
+    if i == j || j == k || i == k {
+        return true;
+    }
+    let [a, b, c] = [i, j, k].map(|v| mesh.positions[v as usize]);
+    collinear(a, b, c)
+}
+
+/// Exact collinearity: all three coordinate-plane projections have zero signed area.
+fn collinear(a: V, b: V, c: V) -> bool {
+    (0..3).all(|k| o2(proj(a, k), proj(b, k), proj(c, k)) == 0)
+}
+
+fn shared_positions(mesh: &TriMesh, a: usize, b: usize) -> usize {
+    let ta = mesh.triangles[a].map(|i| mesh.positions[i as usize]);
+    let tb = mesh.triangles[b].map(|i| mesh.positions[i as usize]);
+    ta.iter().filter(|p| tb.contains(p)).count()
 }
 
 /// Broad phase on a uniform grid (about one cell per triangle) over the triangles'
@@ -57,10 +116,29 @@ pub fn check_crust(mesh: &TriMesh) -> Result<CrustCheck, String> {
 /// position. Returns the number of pairs tested and the first intersecting pair (stopping
 /// there if `stop_at_first`).
 ///
+/// Pairs that share a vertex position are not tested here (see [`check_crust`], which
+/// also tests those).
+///
 /// # Complexity
 /// O(F) expected for evenly sized triangles, plus the exact tests.
 pub fn self_intersections(mesh: &TriMesh, stop_at_first: bool) -> (usize, Option<(usize, usize)>) {
+    let s = scan(mesh, stop_at_first, false);
+    (s.disjoint_tested, s.hits.first().copied())
+}
+
+struct Scan {
+    disjoint_tested: usize,
+    adjacent_tested: usize,
+    /// Meeting pairs (a < b), sorted; only the first found when stopping at the first.
+    hits: Vec<(usize, usize)>,
+}
+
+/// The broad phase of [`self_intersections`]; with `adjacent`, pairs sharing one or two
+/// vertex positions are tested too ([`adjacent_overlap`]) and pairs sharing three count
+/// as meeting. Degenerate triangles are skipped when `adjacent` (the caller reports them).
+fn scan(mesh: &TriMesh, stop_at_first: bool, adjacent: bool) -> Scan {
     let n = mesh.triangles.len();
+    let mut out = Scan { disjoint_tested: 0, adjacent_tested: 0, hits: Vec::new() };
     let tri = |t: usize| mesh.triangles[t].map(|i| mesh.positions[i as usize]);
     let boxes: Vec<(V, V)> = (0..n)
         .map(|t| {
@@ -71,14 +149,18 @@ pub fn self_intersections(mesh: &TriMesh, stop_at_first: bool) -> (usize, Option
         })
         .collect();
     if n < 2 {
-        return (0, None);
+        return out;
     }
+    let skip: Vec<bool> = if adjacent { (0..n).map(|t| is_degenerate(mesh, t)).collect() } else { vec![false; n] };
     let (lo, hi) = mesh.bounding_box();
     let res = ((n as f64).cbrt().ceil() as usize).clamp(1, 512);
     let size = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / res as f64).max(f64::MIN_POSITIVE));
     let cell = |p: V, k: usize| (((p[k] - lo[k]) / size[k]) as usize).min(res - 1);
     let mut buckets: std::collections::HashMap<(usize, usize, usize), Vec<u32>> = std::collections::HashMap::new();
     for (t, (blo, bhi)) in boxes.iter().enumerate() {
+        if skip[t] {
+            continue;
+        }
         for i in cell(*blo, 0)..=cell(*bhi, 0) {
             for j in cell(*blo, 1)..=cell(*bhi, 1) {
                 for k in cell(*blo, 2)..=cell(*bhi, 2) {
@@ -89,8 +171,6 @@ pub fn self_intersections(mesh: &TriMesh, stop_at_first: bool) -> (usize, Option
     }
     let mut keys: Vec<_> = buckets.keys().copied().collect();
     keys.sort_unstable();
-    let mut tested = 0;
-    let mut first: Option<(usize, usize)> = None;
     for key in keys {
         let ts = &buckets[&key];
         for (x, &a) in ts.iter().enumerate() {
@@ -105,23 +185,76 @@ pub fn self_intersections(mesh: &TriMesh, stop_at_first: bool) -> (usize, Option
                     continue; // tested in another cell
                 }
                 let (ta, tb) = (tri(a as usize), tri(b as usize));
-                if ta.iter().any(|p| tb.iter().any(|q| p == q)) {
-                    continue;
-                }
-                tested += 1;
-                if triangles_intersect(ta, tb) {
-                    let pair = ((a.min(b)) as usize, (a.max(b)) as usize);
-                    if first.is_none_or(|f| pair < f) {
-                        first = Some(pair);
+                let meet = if ta.iter().any(|p| tb.contains(p)) {
+                    if !adjacent {
+                        continue;
                     }
+                    out.adjacent_tested += 1;
+                    adjacent_overlap(ta, tb)
+                } else {
+                    out.disjoint_tested += 1;
+                    triangles_intersect(ta, tb)
+                };
+                if meet {
+                    out.hits.push(((a.min(b)) as usize, (a.max(b)) as usize));
                     if stop_at_first {
-                        return (tested, first);
+                        return out;
                     }
                 }
             }
         }
     }
-    (tested, first)
+    out.hits.sort_unstable();
+    out
+}
+
+/// Exact test for non-degenerate triangles that share one or more vertex positions: do
+/// they meet anywhere but at their shared vertices and the edge between them?
+pub fn adjacent_overlap(a: [V; 3], b: [V; 3]) -> bool {
+    let mut shared = Vec::with_capacity(3);
+    for i in 0..3 {
+        if let Some(j) = (0..3).find(|&j| b[j] == a[i]) {
+            shared.push((i, j));
+        }
+    }
+    match shared.len() {
+        0 => triangles_intersect(a, b),
+        1 => {
+            let (i, j) = shared[0];
+            let p = a[i];
+            let (a1, a2) = (a[(i + 1) % 3], a[(i + 2) % 3]);
+            let (b1, b2) = (b[(j + 1) % 3], b[(j + 2) % 3]);
+            // Both are convex and contain p, so they meet elsewhere iff the edge opposite p
+            // in one meets the other, or an edge at p runs into the other (then it lies in
+            // the other's plane, inside its angle at p).
+            segment_meets_triangle(a1, a2, b)
+                || segment_meets_triangle(b1, b2, a)
+                || [a1, a2].iter().any(|&x| o3(p, b1, b2, x) == 0 && in_angle(p, b1, b2, x))
+                || [b1, b2].iter().any(|&x| o3(p, a1, a2, x) == 0 && in_angle(p, a1, a2, x))
+        }
+        2 => {
+            // A shared edge (p, q): the triangles meet elsewhere iff they are coplanar and
+            // lie on the same side of it (a fold).
+            let (p, q) = (a[shared[0].0], a[shared[1].0]);
+            let x = a[(0..3).find(|&i| shared.iter().all(|s| s.0 != i)).unwrap_or(0)];
+            let y = b[(0..3).find(|&j| shared.iter().all(|s| s.1 != j)).unwrap_or(0)];
+            if o3(p, q, x, y) != 0 {
+                return false;
+            }
+            let k = (0..3).find(|&k| o2(proj(p, k), proj(q, k), proj(x, k)) != 0).unwrap_or(2);
+            o2(proj(p, k), proj(q, k), proj(x, k)) == o2(proj(p, k), proj(q, k), proj(y, k))
+        }
+        _ => true,
+    }
+}
+
+/// For `x` in the plane of the non-degenerate triangle (p, b1, b2): does `x` lie in the
+/// closed angle of the triangle at p (so the segment p→x enters the triangle)?
+fn in_angle(p: V, b1: V, b2: V, x: V) -> bool {
+    let k = (0..3).find(|&k| o2(proj(p, k), proj(b1, k), proj(b2, k)) != 0).unwrap_or(2);
+    let (p, b1, b2, x) = (proj(p, k), proj(b1, k), proj(b2, k), proj(x, k));
+    let s = o2(p, b1, b2);
+    o2(p, b1, x) * s >= 0 && o2(p, x, b2) * s >= 0
 }
 
 fn c3(p: V) -> Coord3D<f64> {

@@ -18,6 +18,10 @@ pub enum CrustError {
     /// The Delaunay tetrahedralization failed.
     #[error("Delaunay tetrahedralization of the sites failed: {0}")]
     Delaunay(#[from] delaunay3::DelaunayError),
+    /// The crust cannot be written as asked: the map to the output frame or the output's
+    /// precision cannot hold it ([`crate::output::finalize`]).
+    #[error("the crust cannot be written in the output's frame and precision: {0}")]
+    Unwritable(String),
     /// A guarantee failed to hold: a bug, reported rather than written out.
     #[error("internal error, the crust would not be valid: {0}")]
     Internal(String),

@@ -5,9 +5,10 @@ use std::time::Instant;
 use delaunay3::Delaunay3;
 use mesh_io::TriMesh;
 
+use crate::check::{check_crust, CrustCheck};
 use crate::circumcenter::circumcenter;
 use crate::error::CrustError;
-use crate::manifold;
+use crate::resolve::{self, Target};
 
 /// Where the crust lives.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,6 +42,11 @@ pub struct CrustStats {
     pub num_voronoi_vertices: usize,
     /// Extra vertex copies made where inside cells touch only along an edge or at a point.
     pub num_split_vertices: usize,
+    /// Voronoi vertices merged into a neighbour because their rounded positions broke the
+    /// crust (nearly degenerate sites; see [`Crust::extract`]). 0 almost always.
+    pub num_merged_vertices: usize,
+    /// The largest crust-edge length (max-norm) merged to repair rounding, 0 when none.
+    pub merge_distance: f64,
     pub delaunay_seconds: f64,
     pub total_seconds: f64,
 }
@@ -54,6 +60,9 @@ pub struct Crust {
     /// - `mesh.triangles`: #F×3 u32, counter-clockwise seen from outside.
     pub mesh: TriMesh,
     pub stats: CrustStats,
+    /// The exact checker's report on `mesh` ([`crate::check::check_crust`]), which it
+    /// passed: extraction checks what it returns.
+    pub check: CrustCheck,
     /// The tetrahedralization and labels, kept for [`Crust::cells`].
     state: Option<State>,
 }
@@ -140,13 +149,28 @@ impl Crust {
     /// The mesh is closed (every edge in exactly two triangles, with opposite
     /// orientations), vertex-manifold (where inside cells touch only along an edge or at
     /// a point, vertices are split), consistently oriented with normals from inside to
-    /// outside sites, and its volume equals the summed volume of the inside cells.
-    /// [`crate::check::check_crust`] verifies all of it, including exact freedom from
-    /// self-intersections.
+    /// outside sites, and its volume equals the summed volume of the inside cells (up to
+    /// the rounding below). [`crate::check::check_crust`] verifies all of it, including
+    /// exact freedom from self-intersections, and extraction runs it on what it returns
+    /// ([`Crust::check`]).
+    ///
+    /// # Nearly degenerate sites
+    /// Exactly cospherical tetrahedra share one Voronoi vertex (exact in-sphere test).
+    /// Nearly cospherical ones — mirrored pairs across a smooth surface are so by
+    /// construction: any three pairs are cospherical in exact arithmetic, but not after
+    /// their coordinates are rounded — have distinct Voronoi vertices a few ulps to a few
+    /// hundred ulps apart, joined by tiny edges and sliver faces, and rounding those
+    /// vertices to f64 can make triangles cross or fold. When the exact check fails, the
+    /// crust vertices around the faulty triangles that are joined by crust edges no longer
+    /// than a growing distance (0, then 1, 4, 16, … units in the last place) are merged —
+    /// the degenerate vertex the sites nearly have — and the polygons rebuilt, until the
+    /// check passes (see `src/resolve.rs`). Sites never move; [`CrustStats`] counts the
+    /// merged vertices.
     ///
     /// # Complexity
     /// One or two Delaunay tetrahedralizations, then O(crust size) plus the circumcentres
-    /// of the tetrahedra around inside sites near the box faces.
+    /// of the tetrahedra around inside sites near the box faces, and the exact check of
+    /// the result (about 20% of the total on uniform sites).
     ///
     /// # Errors
     /// Mismatched lengths, NaN, sites not strictly inside the box, a bad box; an internal
@@ -163,7 +187,9 @@ impl Crust {
         };
         if stats.num_inside == 0 {
             stats.total_seconds = start.elapsed().as_secs_f64();
-            return Ok(Crust { mesh: TriMesh::default(), stats, state: None });
+            let mesh = TriMesh::default();
+            let check = check_crust(&mesh).map_err(CrustError::Internal)?;
+            return Ok(Crust { mesh, stats, check, state: None });
         }
 
         // Pass 1: which inside cells reach past which box faces.
@@ -230,11 +256,22 @@ impl Crust {
             }
         }
         stats.num_polygons = polygons.len();
-        let (mesh, num_used, num_split) = manifold::build(&polygons, &vv.positions)?;
-        stats.num_voronoi_vertices = num_used;
-        stats.num_split_vertices = num_split;
+        // The vertices are rounded circumcentres: check the mesh exactly, and where
+        // rounding broke it (nearly degenerate sites), merge what f64 cannot keep apart.
+        let target = Target { round: |x| x, epsilon: f64::EPSILON, distinct_positions: false };
+        let (built, check) = match resolve::attempt(&polygons, &vv.positions, &target) {
+            Ok((built, check, _)) => (built, check),
+            Err(first) => {
+                let o = resolve::resolve(&polygons, &vv.positions, &target, first)?;
+                stats.num_merged_vertices = o.num_merged;
+                stats.merge_distance = o.merge_distance;
+                (o.built, o.check)
+            }
+        };
+        stats.num_voronoi_vertices = built.num_used;
+        stats.num_split_vertices = built.num_split;
         stats.total_seconds = start.elapsed().as_secs_f64();
-        Ok(Crust { mesh, stats, state: Some(State { dt, inside: vertex_inside, vv }) })
+        Ok(Crust { mesh: built.mesh, stats, check, state: Some(State { dt, inside: vertex_inside, vv }) })
     }
 
     /// Every inside cell (clipped to the box) as a closed convex polyhedron, fan

@@ -19,6 +19,8 @@ pub mod circumcenter;
 mod error;
 mod extract;
 mod manifold;
+pub mod output;
+mod resolve;
 mod sites_file;
 
 pub use error::{CrustError, SitesFileError};

@@ -7,7 +7,7 @@
 //! by angle (each face with its neighbour on its inside side, so each pair bounds one
 //! wedge of solid), and each vertex is split into one copy per umbrella of faces.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use mesh_io::TriMesh;
 
@@ -25,6 +25,7 @@ fn dot(a: V, b: V) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+
 /// Newell normal of a polygon (not normalised).
 fn newell(poly: &[u32], pos: &[V]) -> V {
     let mut n = [0.0; 3];
@@ -37,10 +38,26 @@ fn newell(poly: &[u32], pos: &[V]) -> V {
     n
 }
 
-/// Build the mesh. `polygons`: oriented Voronoi faces as ids into `positions`
-/// (#P×3 f64). Returns the mesh, the number of distinct Voronoi vertices used and the
-/// number of extra copies made by splitting.
-pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, usize, usize), CrustError> {
+/// A built mesh and where its vertices come from.
+pub(crate) struct Built {
+    pub mesh: TriMesh,
+    /// Distinct polygon vertex ids used.
+    pub num_used: usize,
+    /// Extra copies made by splitting and midpoints.
+    pub num_split: usize,
+    /// Per mesh vertex: the polygon vertex id it copies (for a computed vertex, one of the
+    /// polygon vertices it was computed from).
+    pub source: Vec<u32>,
+    /// Per mesh vertex: whether its position is computed (an edge midpoint or a polygon
+    /// centroid) rather than copied.
+    pub computed: Vec<bool>,
+    /// Per triangle: the polygon it triangulates.
+    pub face_of_triangle: Vec<u32>,
+}
+
+/// Build the mesh. `polygons`: oriented simple polygons (no vertex repeated) as ids into
+/// `positions` (#P×3 f64).
+pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, CrustError> {
     // Half-edge h = offset[f] + i goes from polygons[f][i] to polygons[f][i + 1].
     let mut offset = Vec::with_capacity(polygons.len() + 1);
     let mut total = 0usize;
@@ -96,6 +113,7 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, 
     // vertex, at the start of twin(prev(h)).
     let mut corner_vertex = vec![u32::MAX; total];
     let mut mesh = TriMesh::default();
+    let mut source: Vec<u32> = Vec::new();
     let mut used = vec![false; positions.len()];
     let mut copies = 0usize;
     for h0 in 0..total {
@@ -105,6 +123,7 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, 
         let v = from(h0);
         let id = mesh.positions.len() as u32;
         mesh.positions.push(positions[v as usize]);
+        source.push(v);
         if used[v as usize] {
             copies += 1;
         }
@@ -138,6 +157,7 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, 
         }
     }
     let mut midpoint_after = vec![u32::MAX; total];
+    let mut computed = vec![false; mesh.positions.len()];
     for h in 0..total {
         let g = twin[h];
         if g < h || count[&key(h)] < 2 {
@@ -147,14 +167,24 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, 
         let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
         let w = mesh.positions.len() as u32;
         mesh.positions.push([0, 1, 2].map(|k| 0.5 * (pa[k] + pb[k])));
+        source.push(source[a as usize]);
+        computed.push(true);
         copies += 1;
         midpoint_after[h] = w;
         midpoint_after[g] = w;
     }
-    let mut ids = Vec::new();
+    // Triangulate each polygon without new edges that exist elsewhere (convex Voronoi faces
+    // share at most an edge, but polygons rebuilt after merging vertices, see `resolve`,
+    // may share two corners that are not neighbours) and, in the projection along its
+    // dominant normal axis, without a triangle of the wrong orientation or zero area
+    // (exact orient2d): rebuilt polygons can be non-convex, with corners bent by an ulp.
+    // A fan from the preferred corner if that works, else from another corner, else ear
+    // clipping, else a fan from a new vertex at the centroid.
+    let mut taken: HashSet<(u32, u32)> = HashSet::new();
+    let mut polys: Vec<(Vec<u32>, usize)> = Vec::with_capacity(polygons.len());
     for (f, p) in polygons.iter().enumerate() {
         let o = offset[f];
-        ids.clear();
+        let mut ids = Vec::with_capacity(p.len() + 1);
         let mut apex = 0;
         for i in 0..p.len() {
             ids.push(corner_vertex[o + i]);
@@ -165,14 +195,117 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<(TriMesh, 
                 apex = ids.len() - 1;
             }
         }
-        let n = ids.len();
-        for k in 1..n - 1 {
-            let (a, b, c) = (ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]);
-            mesh.triangles.push([a, b, c]);
+        for i in 0..ids.len() {
+            taken.insert(ukey(ids[i], ids[(i + 1) % ids.len()]));
         }
+        polys.push((ids, apex));
     }
-    let distinct = used.iter().filter(|&&u| u).count();
-    Ok((mesh, distinct, copies))
+    let mut face_of_triangle: Vec<u32> = Vec::new();
+    let mut tris = Vec::new();
+    for (fi, (ids, preferred)) in polys.iter().enumerate() {
+        tris.clear();
+        if triangulate(ids, *preferred, &mesh.positions, &taken, &mut tris) {
+            for &[a, b, c] in &tris {
+                for (x, y) in [(a, b), (b, c), (c, a)] {
+                    taken.insert(ukey(x, y));
+                }
+            }
+        } else {
+            let n = ids.len();
+            let w = mesh.positions.len() as u32;
+            let c = [0, 1, 2].map(|k| ids.iter().map(|&v| mesh.positions[v as usize][k]).sum::<f64>() / n as f64);
+            mesh.positions.push(c);
+            source.push(source[ids[0] as usize]);
+            computed.push(true);
+            copies += 1;
+            for k in 0..n {
+                tris.push([w, ids[k], ids[(k + 1) % n]]);
+            }
+        }
+        mesh.triangles.extend_from_slice(&tris);
+        face_of_triangle.extend(std::iter::repeat_n(fi as u32, tris.len()));
+    }
+    let num_used = used.iter().filter(|&&u| u).count();
+    Ok(Built { mesh, num_used, num_split: copies, source, computed, face_of_triangle })
+}
+
+fn ukey(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// Triangulate the polygon `ids` (mesh vertex ids, counter-clockwise seen from outside)
+/// into `out`: every triangle positively oriented in the projection along the polygon's
+/// dominant normal axis (exact orient2d), no new edge in `taken`. `false` when neither a
+/// fan (from `preferred` first) nor ear clipping finds one.
+fn triangulate(ids: &[u32], preferred: usize, positions: &[V], taken: &HashSet<(u32, u32)>, out: &mut Vec<[u32; 3]>) -> bool {
+    let n = ids.len();
+    if n == 3 {
+        out.push([ids[0], ids[1], ids[2]]);
+        return true;
+    }
+    let normal = newell(ids, positions);
+    let axis = (0..3).max_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs())).unwrap_or(2);
+    if !(normal[axis] != 0.0) {
+        return false;
+    }
+    // Drop `axis`; keep the orientation: (x, y) chosen so that a polygon counter-clockwise
+    // about +axis is counter-clockwise in 2D, then flip when the normal points along −axis.
+    let flip = normal[axis] < 0.0;
+    let pt = |v: u32| {
+        let p = positions[v as usize];
+        let (x, y) = match axis {
+            0 => (p[1], p[2]),
+            1 => (p[2], p[0]),
+            _ => (p[0], p[1]),
+        };
+        robust::Coord { x, y: if flip { -y } else { y } }
+    };
+    let ccw = |a: u32, b: u32, c: u32| robust::orient2d(pt(a), pt(b), pt(c)) > 0.0;
+    let fan_ok = |apex: usize| {
+        (2..n - 1).all(|k| !taken.contains(&ukey(ids[apex], ids[(apex + k) % n])))
+            && (1..n - 1).all(|k| ccw(ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]))
+    };
+    if let Some(apex) = std::iter::once(preferred).chain((0..n).filter(|&a| a != preferred)).find(|&a| fan_ok(a)) {
+        for k in 1..n - 1 {
+            out.push([ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]]);
+        }
+        return true;
+    }
+    // Ear clipping: a corner whose triangle is counter-clockwise, contains no other corner
+    // (closed test) and whose new edge is not taken.
+    let mut ring: Vec<u32> = ids.to_vec();
+    let mut new_edges: HashSet<(u32, u32)> = HashSet::new();
+    while ring.len() > 3 {
+        let m = ring.len();
+        let ear = (0..m).find(|&i| {
+            let (a, b, c) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
+            if !ccw(a, b, c) || taken.contains(&ukey(a, c)) || new_edges.contains(&ukey(a, c)) {
+                return false;
+            }
+            let (pa, pb, pc) = (pt(a), pt(b), pt(c));
+            ring.iter().all(|&v| {
+                if v == a || v == b || v == c {
+                    return true;
+                }
+                let q = pt(v);
+                !(robust::orient2d(pa, pb, q) >= 0.0 && robust::orient2d(pb, pc, q) >= 0.0 && robust::orient2d(pc, pa, q) >= 0.0)
+            })
+        });
+        let Some(i) = ear else {
+            out.clear();
+            return false;
+        };
+        let (a, b, c) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
+        out.push([a, b, c]);
+        new_edges.insert(ukey(a, c));
+        ring.remove(i);
+    }
+    if !ccw(ring[0], ring[1], ring[2]) {
+        out.clear();
+        return false;
+    }
+    out.push([ring[0], ring[1], ring[2]]);
+    true
 }
 
 /// Pair the 2k half-edges around edge (u, v) by the angle of their faces about the edge.

@@ -15,7 +15,8 @@ use std::io::Cursor;
 use std::path::Path;
 
 use ndarray::{Array1, Array2};
-use ndarray_npy::{NpzReader, NpzWriter};
+use ndarray_npy::NpzReader;
+use vf_common::npz::NpzOut;
 
 use crate::error::SitesFileError;
 
@@ -110,22 +111,17 @@ impl SitesFile {
 
     /// Write the file atomically.
     pub fn write(&self, path: &Path) -> Result<(), SitesFileError> {
-        let encode = |e: ndarray_npy::WriteNpzError| SitesFileError::Invalid {
-            path: path.display().to_string(),
-            message: format!("cannot encode ({e})"),
+        let fail = |e: vf_common::npz::NpzError| match e {
+            vf_common::npz::NpzError::Write(e) => SitesFileError::from(e),
+            e => SitesFileError::Invalid { path: path.display().to_string(), message: e.to_string() },
         };
-        let mut w = NpzWriter::new(Cursor::new(Vec::new()));
-        let sites =
-            Array2::from_shape_vec((self.sites.len(), 3), self.sites.iter().flatten().copied().collect()).expect("K×3");
-        w.add_array("sites", &sites).map_err(encode)?;
-        w.add_array("labels", &Array1::from(self.inside.iter().map(|&b| b as u8).collect::<Vec<u8>>()))
-            .map_err(encode)?;
+        let mut npz = NpzOut::new();
+        npz.add_rows("sites", &self.sites)
+            .and_then(|w| w.add_vec("labels", self.inside.iter().map(|&b| b as u8).collect::<Vec<u8>>()))
+            .map_err(fail)?;
         let t = Array2::from_shape_vec((4, 4), self.transform.iter().flatten().copied().collect()).expect("4×4");
-        w.add_array("transform", &t).map_err(encode)?;
-        w.add_array("format_version", &Array1::from(vec![FORMAT_VERSION])).map_err(encode)?;
-        let bytes = w.finish().map_err(encode)?.into_inner();
-        mesh_io::atomic_write(path, |out| out.write_all(&bytes))?;
-        Ok(())
+        npz.add("transform", &t).and_then(|w| w.add_vec("format_version", vec![FORMAT_VERSION])).map_err(fail)?;
+        npz.write(path).map_err(fail)
     }
 }
 

@@ -15,6 +15,7 @@
 mod build;
 mod edges;
 mod error;
+mod fp;
 pub mod normalize;
 pub mod predicates;
 mod spatial_sort;

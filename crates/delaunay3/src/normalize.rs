@@ -1,6 +1,6 @@
 //! Input checking and exact power-of-two normalisation.
 //!
-//! Shewchuk's adaptive predicates (and the stage-A filters in [`crate::predicates`]) are
+//! Shewchuk's adaptive predicates (and the crate's stage-A filters in front of them) are
 //! exact as long as no intermediate product overflows or underflows. Multiplying every
 //! coordinate by the same power of two `2^k` is exact in binary floating point and
 //! preserves the sign of every orientation and in-sphere determinant (they are
@@ -9,7 +9,7 @@
 //! fit are rejected.
 
 use crate::error::DelaunayError;
-use crate::predicates::Point;
+use crate::fp::{exponent, Point};
 
 /// The range the predicates run in, after scaling by `2^k`.
 ///
@@ -41,18 +41,6 @@ impl SafeRange {
     pub const MAX_EXP: i32 = 189;
     /// Largest accepted `floor(log2 max) − floor(log2 min nonzero)`.
     pub const MAX_SPAN_BITS: i32 = Self::MAX_EXP - Self::MIN_EXP;
-}
-
-/// floor(log2 |x|) for finite nonzero x, subnormals included.
-pub(crate) fn exponent(x: f64) -> i32 {
-    let bits = x.abs().to_bits();
-    let e = (bits >> 52) as i32;
-    if e > 0 {
-        e - 1023
-    } else {
-        let mantissa = bits & ((1u64 << 52) - 1);
-        63 - mantissa.leading_zeros() as i32 - 1074
-    }
 }
 
 /// Multiply by `2^k` exactly (two steps so that `2^k` itself need not be representable;
@@ -136,17 +124,6 @@ pub(crate) fn normalize(points: &[[f64; 3]]) -> Result<Normalized, DelaunayError
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn exponent_of_normals_and_subnormals() {
-        assert_eq!(exponent(1.0), 0);
-        assert_eq!(exponent(1.5), 0);
-        assert_eq!(exponent(-3.0), 1);
-        assert_eq!(exponent(0.25), -2);
-        assert_eq!(exponent(f64::MIN_POSITIVE), -1022);
-        assert_eq!(exponent(5e-324), -1074);
-        assert_eq!(exponent(f64::MAX), 1023);
-    }
 
     #[test]
     fn scaling_is_exact_and_reversible() {

@@ -29,8 +29,8 @@
 use robust::Coord3D;
 use std::cmp::Ordering;
 
-/// A point in the crate's internal (power-of-two scaled) frame: 3 f64.
-pub type Point = [f64; 3];
+use crate::fp::exponent;
+pub use crate::fp::Point;
 
 const EPSILON: f64 = f64::EPSILON * 0.5; // 2^-53, Shewchuk's epsilon
 const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * EPSILON) * EPSILON;
@@ -126,7 +126,7 @@ fn small_int_diffs<const N: usize>(ps: [&Point; N], o: &Point) -> Option<[[i64; 
     if max == 0.0 {
         return Some([[0; 3]; N]);
     }
-    let s = 21 - crate::normalize::exponent(max);
+    let s = 21 - exponent(max);
     if !(-1000..=1000).contains(&s) {
         return None;
     }

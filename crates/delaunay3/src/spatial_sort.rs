@@ -7,6 +7,8 @@
 //! Median splits adapt to the point distribution, so strongly clustered inputs (points
 //! with exponentially varying spacing) are ordered as well as uniform ones.
 
+use vf_common::rng::{SplitMix64, Stream};
+
 use crate::predicates::Point;
 
 /// A point with its index, sorted together for locality.
@@ -23,30 +25,12 @@ const MULTISCALE_RATIO: f64 = 0.25;
 /// Hilbert recursion stops at this many points.
 const HILBERT_LIMIT: usize = 4;
 
-/// Deterministic SplitMix64 generator (Steele, Lea & Flood 2014).
-pub(crate) struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in `0..n` (n > 0), by Lemire's multiply-shift (bias below 2^-32 here).
-    pub fn below(&mut self, n: usize) -> usize {
-        (((self.next_u64() >> 32) * n as u64) >> 32) as usize
-    }
-}
-
 /// BRIO + Hilbert order of `items`, in place. Deterministic (fixed seed).
 ///
 /// # Complexity
 /// O(n log n) time, no allocation.
 pub(crate) fn brio_hilbert_sort(items: &mut [Item]) {
-    let mut rng = SplitMix64(0x5EED_DE1A_0A17);
+    let mut rng = SplitMix64::from_state(Stream::DelaunayInsertion as u64);
     // Fisher–Yates shuffle: the randomisation of BRIO.
     for i in (1..items.len()).rev() {
         let j = rng.below(i + 1);
@@ -112,7 +96,7 @@ mod tests {
 
     #[test]
     fn sort_is_a_permutation_and_local() {
-        let mut rng = SplitMix64(7);
+        let mut rng = SplitMix64::from_state(7);
         let n = 4096;
         let mut items: Vec<Item> = (0..n)
             .map(|i| Item {

@@ -20,6 +20,10 @@ pub enum ErrorKind {
     Truncated,
     /// A coordinate is NaN or infinite.
     NonFinite,
+    /// Finite, but outside the range this program handles: a coordinate beyond ±1e30, an
+    /// extent below 1e-30, or float32 output that cannot resolve the mesh (see
+    /// [`crate::limits`]).
+    Unrepresentable,
     /// A face refers to a vertex that does not exist.
     IndexOutOfRange,
     /// The file parses but holds no triangle.
@@ -113,6 +117,7 @@ fn default_hint(kind: ErrorKind) -> &'static str {
         ErrorKind::NonFinite => {
             "Every coordinate must be a finite number; remove or repair the vertex in the program that made the file."
         }
+        ErrorKind::Unrepresentable => "Rescale the mesh in the program that made it.",
         ErrorKind::IndexOutOfRange => {
             "Faces may only refer to vertices the file defines; re-export the mesh or remove the face."
         }

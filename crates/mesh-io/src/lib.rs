@@ -1,12 +1,17 @@
 //! Triangle meshes for voronoi-fit.
 //!
 //! Entry type: [`TriMesh`]. Entry functions: [`read_mesh`] (any supported format, chosen by
-//! content and extension), [`write_mesh`] / [`write_gltf`] (atomic),
-//! [`TopologyReport::of`] and [`UnitCubeTransform`].
+//! content and extension; refuses coordinates outside the range of [`limits`]),
+//! [`write_mesh`] / [`write_gltf`] (atomic), [`TopologyReport::of`] and
+//! [`UnitCubeTransform`]. Checks before long work: [`OutputFormat::from_path`],
+//! [`check_output_location`], [`check_f32_resolution`]. Crack repair:
+//! [`weld::weld_tolerance`], [`weld::count_near_pairs`]. See the crate's README.md.
 
 pub mod atomic;
 pub mod error;
+pub mod limits;
 pub mod normalize;
+pub mod output;
 pub mod read;
 pub mod shapes;
 pub mod topology;
@@ -15,9 +20,12 @@ pub mod write;
 
 pub use atomic::atomic_write;
 pub use error::{ErrorKind, Location, MeshError};
+pub use limits::{check_f32_resolution, check_representable};
 pub use normalize::UnitCubeTransform;
+pub use output::{check_output_location, OutputFormat};
 pub use read::{read_mesh, read_mesh_from_bytes, Format};
 pub use topology::TopologyReport;
+pub use weld::{weld_tolerance, WeldStats};
 pub use write::{vertex_normals, write_gltf, write_mesh, write_obj, write_ply, GltfLayout, SceneMesh};
 
 /// An indexed triangle mesh in f64.
@@ -26,8 +34,9 @@ pub use write::{vertex_normals, write_gltf, write_mesh, write_obj, write_ply, Gl
 /// - `triangles`: #F×3 u32, zero-based indices into `positions`, counter-clockwise seen
 ///   from outside when the mesh is consistently oriented.
 ///
-/// Readers guarantee every coordinate is finite, every index is in range and the mesh has
-/// at least one triangle; code that builds a `TriMesh` by hand can check the same with
+/// Readers guarantee every coordinate is finite and within the representable range
+/// ([`check_representable`]), every index is in range and the mesh has at least one
+/// triangle; code that builds a `TriMesh` by hand can check the same with
 /// [`TriMesh::validate`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {
@@ -76,11 +85,10 @@ impl TriMesh {
         v
     }
 
-    /// Check what readers guarantee: finite coordinates, indices in range (the mesh may be
-    /// empty). `what` names the mesh in the error.
+    /// Check what readers guarantee: finite coordinates in the representable range
+    /// ([`check_representable`]), indices in range (the mesh may be empty). `what` names
+    /// the mesh in the error.
     pub fn validate(&self, what: &std::path::Path) -> Result<(), MeshError> {
-        read::finish(self.clone(), what)
-            .map(|_| ())
-            .or_else(|e| if e.kind == ErrorKind::Empty { Ok(()) } else { Err(e) })
+        read::check_contents(self, what)
     }
 }

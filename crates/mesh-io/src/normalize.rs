@@ -55,11 +55,13 @@ impl UnitCubeTransform {
         }
     }
 
-    /// A copy of `mesh` mapped from the unit cube back to the input frame.
+    /// A copy of `mesh` mapped from the unit cube back to the input frame; a negative
+    /// scale (a mirroring map) reverses every triangle so outward stays outward.
     pub fn mesh_from_unit(&self, mesh: &TriMesh) -> TriMesh {
+        let flip = self.scale < 0.0;
         TriMesh {
             positions: mesh.positions.iter().map(|&u| self.from_unit(u)).collect(),
-            triangles: mesh.triangles.clone(),
+            triangles: mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect(),
         }
     }
 

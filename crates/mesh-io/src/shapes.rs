@@ -3,7 +3,38 @@
 
 use std::collections::HashMap;
 
+use serde::{Deserialize, Serialize};
+
 use crate::TriMesh;
+
+/// A sphere (the boundary of a solid ball): the analytic reference surface of the sphere
+/// study, shared by the training data and the metrics.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sphere {
+    /// Centre.
+    pub center: [f64; 3],
+    /// Radius (> 0).
+    pub radius: f64,
+}
+
+impl Sphere {
+    /// Distance from `p` to the centre, `‖p − center‖` in f64.
+    pub fn center_distance(&self, p: [f64; 3]) -> f64 {
+        let d = [p[0] - self.center[0], p[1] - self.center[1], p[2] - self.center[2]];
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    }
+
+    /// Whether `p` is inside the closed ball (`‖p − center‖ ≤ radius`).
+    pub fn contains(&self, p: [f64; 3]) -> bool {
+        self.center_distance(p) <= self.radius
+    }
+
+    /// Signed distance from `p` to the sphere, `‖p − center‖ − radius`: negative inside,
+    /// zero on the sphere, positive outside.
+    pub fn distance(&self, p: [f64; 3]) -> f64 {
+        self.center_distance(p) - self.radius
+    }
+}
 
 /// Unit-radius icosphere centred at the origin: the icosahedron with each triangle split
 /// into four `subdivisions` times, new vertices projected onto the sphere.
@@ -135,4 +166,25 @@ pub fn box_with_hole_volume(half_width: f64, wall: f64) -> f64 {
 /// The generated meshes shipped in `assets/`, by file stem.
 pub fn asset_shapes() -> Vec<(&'static str, TriMesh)> {
     vec![("icosphere", icosphere(4)), ("torus", torus(1.0, 0.35, 64, 32)), ("box_with_hole", box_with_hole(1.0, 0.3))]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sphere_signed_distance_and_containment() {
+        let s = Sphere { center: [0.5, 0.5, 0.5], radius: 0.25 };
+        assert_eq!(s.distance([0.5, 0.5, 0.5]), -0.25);
+        assert_eq!(s.distance([1.0, 0.5, 0.5]), 0.25);
+        assert_eq!(s.distance([0.5, 0.25, 0.5]), 0.0);
+        assert!(s.contains([0.5, 0.25, 0.5]) && s.contains([0.6, 0.6, 0.6]));
+        assert!(!s.contains([0.5, 0.5, 0.7500001]));
+        // Containment agrees with the sign of the distance.
+        for p in [[0.1, 0.2, 0.3], [0.7, 0.7, 0.7], [0.5, 0.5, 0.75], [0.3, 0.6, 0.4]] {
+            assert_eq!(s.contains(p), s.distance(p) <= 0.0, "{p:?}");
+        }
+        let json = serde_json::to_string(&s).unwrap();
+        assert_eq!(serde_json::from_str::<Sphere>(&json).unwrap(), s);
+    }
 }

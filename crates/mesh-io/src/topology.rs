@@ -103,177 +103,34 @@ impl TopologyReport {
     pub fn of(mesh: &TriMesh) -> TopologyReport {
         let nv = mesh.positions.len();
         let nf = mesh.triangles.len();
-        let p = &mesh.positions;
-
-        let mut referenced = vec![false; nv];
-        for t in &mesh.triangles {
-            for &i in t {
-                referenced[i as usize] = true;
-            }
-        }
+        let referenced = referenced_vertices(mesh);
         let num_referenced_vertices = referenced.iter().filter(|&&r| r).count();
+        let edges = EdgeSummary::of(mesh);
+        let num_non_manifold_vertices = count_non_manifold_vertices(mesh, edges.corner_dsu);
+        let num_components = count_components(mesh, &referenced);
 
-        let num_degenerate_faces = mesh
-            .triangles
-            .iter()
-            .filter(|t| {
-                t[0] == t[1]
-                    || t[1] == t[2]
-                    || t[0] == t[2]
-                    || collinear(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize])
-            })
-            .count();
-
-        let mut sorted_faces: Vec<[u32; 3]> = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let mut s = *t;
-                s.sort_unstable();
-                s
-            })
-            .collect();
-        sorted_faces.sort_unstable();
-        let num_duplicate_faces = sorted_faces.windows(2).filter(|w| w[0] == w[1]).count();
-
-        // Directed half-edges: (min, max, face, forward?) sorted by undirected key.
-        let mut half: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(3 * nf);
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                half.push((a.min(b), a.max(b), f as u32, a < b));
-            }
-        }
-        half.sort_unstable();
-
-        let mut num_edges = 0;
-        let mut num_boundary_edges = 0;
-        let mut num_non_manifold_edges = 0;
-        let mut orientation_ok = true;
-        let mut boundary_dsu = Dsu::new(nv);
-        let mut boundary_vertex = vec![false; nv];
-        // Corners (face, slot) that meet at a vertex across a shared edge belong to one fan.
-        let mut corner_dsu = Dsu::new(3 * nf);
-        let corner = |f: u32, v: u32| -> u32 {
-            let t = mesh.triangles[f as usize];
-            let slot = t.iter().position(|&x| x == v).unwrap_or(0) as u32;
-            3 * f + slot
-        };
-        let mut i = 0;
-        while i < half.len() {
-            let mut j = i;
-            while j < half.len() && half[j].0 == half[i].0 && half[j].1 == half[i].1 {
-                j += 1;
-            }
-            let group = &half[i..j];
-            let (a, b) = (group[0].0, group[0].1);
-            num_edges += 1;
-            match group.len() {
-                1 => {
-                    num_boundary_edges += 1;
-                    boundary_dsu.union(a, b);
-                    boundary_vertex[a as usize] = true;
-                    boundary_vertex[b as usize] = true;
-                }
-                2 => {
-                    if group[0].3 == group[1].3 {
-                        orientation_ok = false;
-                    }
-                }
-                _ => num_non_manifold_edges += 1,
-            }
-            if a != b {
-                for w in group.windows(2) {
-                    corner_dsu.union(corner(w[0].2, a), corner(w[1].2, a));
-                    corner_dsu.union(corner(w[0].2, b), corner(w[1].2, b));
-                }
-            }
-            i = j;
-        }
-        let num_boundary_loops =
-            (0..nv as u32).filter(|&v| boundary_vertex[v as usize] && boundary_dsu.find(v) == v).count();
-
-        // Fans per vertex: distinct corner roots among the vertex's corners.
-        let mut fan_root = vec![u32::MAX; nv];
-        let mut non_manifold_vertex = vec![false; nv];
-        for (f, t) in mesh.triangles.iter().enumerate() {
-            for (slot, &v) in t.iter().enumerate() {
-                if t[..slot].contains(&v) {
-                    continue; // a repeated corner of a degenerate face
-                }
-                let r = corner_dsu.find(3 * f as u32 + slot as u32);
-                let fr = &mut fan_root[v as usize];
-                if *fr == u32::MAX {
-                    *fr = r;
-                } else if *fr != r {
-                    non_manifold_vertex[v as usize] = true;
-                }
-            }
-        }
-        let num_non_manifold_vertices = non_manifold_vertex.iter().filter(|&&b| b).count();
-
-        let mut comp = Dsu::new(nv);
-        for t in &mesh.triangles {
-            comp.union(t[0], t[1]);
-            comp.union(t[1], t[2]);
-        }
-        let num_components = (0..nv as u32).filter(|&v| referenced[v as usize] && comp.find(v) == v).count();
-
-        let euler_characteristic = num_referenced_vertices as i64 - num_edges as i64 + nf as i64;
-        let is_closed = nf > 0 && num_boundary_edges == 0 && num_non_manifold_edges == 0;
-        let is_manifold = num_non_manifold_edges == 0 && num_non_manifold_vertices == 0;
-        let is_orientation_consistent = nf > 0 && orientation_ok;
+        let euler_characteristic = num_referenced_vertices as i64 - edges.num_edges as i64 + nf as i64;
+        let is_closed = nf > 0 && edges.num_boundary_edges == 0 && edges.num_non_manifold_edges == 0;
+        let is_manifold = edges.num_non_manifold_edges == 0 && num_non_manifold_vertices == 0;
+        let is_orientation_consistent = nf > 0 && edges.orientation_ok;
         let twice_genus = 2 * num_components as i64 - euler_characteristic;
         let genus =
             (is_closed && is_manifold && is_orientation_consistent && twice_genus % 2 == 0).then_some(twice_genus / 2);
 
-        let mut bbox_min = [f64::INFINITY; 3];
-        let mut bbox_max = [f64::NEG_INFINITY; 3];
-        for (q, _) in p.iter().zip(&referenced).filter(|(_, &r)| r) {
-            for k in 0..3 {
-                bbox_min[k] = bbox_min[k].min(q[k]);
-                bbox_max[k] = bbox_max[k].max(q[k]);
-            }
-        }
-        // Volume and area relative to the box centre, which keeps the determinants small.
-        let c = [0, 1, 2].map(|k| 0.5 * (bbox_min[k] + bbox_max[k]));
-        let mut volume = 0.0;
-        let mut area = 0.0;
-        let mut normal_sum = [0.0; 3];
-        for t in &mesh.triangles {
-            let [a, b, d] = t.map(|i| {
-                let q = p[i as usize];
-                [q[0] - c[0], q[1] - c[1], q[2] - c[2]]
-            });
-            let cross = [b[1] * d[2] - b[2] * d[1], b[2] * d[0] - b[0] * d[2], b[0] * d[1] - b[1] * d[0]];
-            volume += a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2];
-            let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let e2 = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
-            let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
-            area += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            for k in 0..3 {
-                normal_sum[k] += n[k];
-            }
-        }
-        // Back to the origin as the reference point (trimesh's convention), exactly:
-        // det(a, b, d) = det(a', b', d') + c · ((b' − a') × (d' − a')) for a' = a − c.
-        // Σ N is zero on a closed mesh, so only open meshes, whose "volume" depends on the
-        // reference point anyway, are affected.
-        if !mesh.triangles.is_empty() {
-            volume += c[0] * normal_sum[0] + c[1] * normal_sum[1] + c[2] * normal_sum[2];
-        }
+        let (bbox_min, bbox_max) = referenced_bounding_box(mesh, &referenced);
+        let (signed_volume, surface_area) = volume_and_area(mesh, bbox_min, bbox_max);
 
         TopologyReport {
             format_version: 1,
             num_vertices: nv,
             num_referenced_vertices,
             num_faces: nf,
-            num_edges,
-            num_degenerate_faces,
-            num_duplicate_faces,
-            num_boundary_edges,
-            num_boundary_loops,
-            num_non_manifold_edges,
+            num_edges: edges.num_edges,
+            num_degenerate_faces: count_degenerate_faces(mesh),
+            num_duplicate_faces: count_duplicate_faces(mesh),
+            num_boundary_edges: edges.num_boundary_edges,
+            num_boundary_loops: edges.num_boundary_loops,
+            num_non_manifold_edges: edges.num_non_manifold_edges,
             num_non_manifold_vertices,
             num_components,
             euler_characteristic,
@@ -281,10 +138,203 @@ impl TopologyReport {
             is_closed,
             is_manifold,
             is_orientation_consistent,
-            signed_volume: volume / 6.0,
-            surface_area: area,
+            signed_volume,
+            surface_area,
             bbox_min,
             bbox_max,
         }
     }
+}
+
+/// Which vertices some face uses.
+fn referenced_vertices(mesh: &TriMesh) -> Vec<bool> {
+    let mut referenced = vec![false; mesh.positions.len()];
+    for t in &mesh.triangles {
+        for &i in t {
+            referenced[i as usize] = true;
+        }
+    }
+    referenced
+}
+
+/// Faces with a repeated vertex or three exactly collinear corners.
+fn count_degenerate_faces(mesh: &TriMesh) -> usize {
+    let p = &mesh.positions;
+    mesh.triangles
+        .iter()
+        .filter(|t| {
+            t[0] == t[1]
+                || t[1] == t[2]
+                || t[0] == t[2]
+                || collinear(p[t[0] as usize], p[t[1] as usize], p[t[2] as usize])
+        })
+        .count()
+}
+
+/// Faces whose vertex set equals that of an earlier face.
+fn count_duplicate_faces(mesh: &TriMesh) -> usize {
+    let mut sorted_faces: Vec<[u32; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let mut s = *t;
+            s.sort_unstable();
+            s
+        })
+        .collect();
+    sorted_faces.sort_unstable();
+    sorted_faces.windows(2).filter(|w| w[0] == w[1]).count()
+}
+
+/// What one pass over the sorted half-edges finds.
+struct EdgeSummary {
+    num_edges: usize,
+    num_boundary_edges: usize,
+    num_boundary_loops: usize,
+    num_non_manifold_edges: usize,
+    orientation_ok: bool,
+    /// Corners `3·face + slot`, joined when they meet at a vertex across a shared edge:
+    /// each class is one fan.
+    corner_dsu: Dsu,
+}
+
+impl EdgeSummary {
+    fn of(mesh: &TriMesh) -> EdgeSummary {
+        let nv = mesh.positions.len();
+        let half = sorted_half_edges(mesh);
+        let mut s = EdgeSummary {
+            num_edges: 0,
+            num_boundary_edges: 0,
+            num_boundary_loops: 0,
+            num_non_manifold_edges: 0,
+            orientation_ok: true,
+            corner_dsu: Dsu::new(3 * mesh.triangles.len()),
+        };
+        let mut boundary_dsu = Dsu::new(nv);
+        let mut boundary_vertex = vec![false; nv];
+        let corner = |f: u32, v: u32| -> u32 {
+            let t = mesh.triangles[f as usize];
+            let slot = t.iter().position(|&x| x == v).unwrap_or(0) as u32;
+            3 * f + slot
+        };
+        for group in half.chunk_by(|x, y| x.0 == y.0 && x.1 == y.1) {
+            let (a, b) = (group[0].0, group[0].1);
+            s.num_edges += 1;
+            match group.len() {
+                1 => {
+                    s.num_boundary_edges += 1;
+                    boundary_dsu.union(a, b);
+                    boundary_vertex[a as usize] = true;
+                    boundary_vertex[b as usize] = true;
+                }
+                2 => {
+                    if group[0].3 == group[1].3 {
+                        s.orientation_ok = false;
+                    }
+                }
+                _ => s.num_non_manifold_edges += 1,
+            }
+            if a != b {
+                for w in group.windows(2) {
+                    s.corner_dsu.union(corner(w[0].2, a), corner(w[1].2, a));
+                    s.corner_dsu.union(corner(w[0].2, b), corner(w[1].2, b));
+                }
+            }
+        }
+        s.num_boundary_loops =
+            (0..nv as u32).filter(|&v| boundary_vertex[v as usize] && boundary_dsu.find(v) == v).count();
+        s
+    }
+}
+
+/// Directed half-edges `(min, max, face, forward?)`, sorted by their undirected key.
+fn sorted_half_edges(mesh: &TriMesh) -> Vec<(u32, u32, u32, bool)> {
+    let mut half: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(3 * mesh.triangles.len());
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            half.push((a.min(b), a.max(b), f as u32, a < b));
+        }
+    }
+    half.sort_unstable();
+    half
+}
+
+/// Vertices whose corners fall in more than one fan (distinct corner roots).
+fn count_non_manifold_vertices(mesh: &TriMesh, mut corner_dsu: Dsu) -> usize {
+    let nv = mesh.positions.len();
+    let mut fan_root = vec![u32::MAX; nv];
+    let mut non_manifold_vertex = vec![false; nv];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for (slot, &v) in t.iter().enumerate() {
+            if t[..slot].contains(&v) {
+                continue; // a repeated corner of a degenerate face
+            }
+            let r = corner_dsu.find(3 * f as u32 + slot as u32);
+            let fr = &mut fan_root[v as usize];
+            if *fr == u32::MAX {
+                *fr = r;
+            } else if *fr != r {
+                non_manifold_vertex[v as usize] = true;
+            }
+        }
+    }
+    non_manifold_vertex.iter().filter(|&&b| b).count()
+}
+
+/// Connected components through shared vertices, over referenced vertices.
+fn count_components(mesh: &TriMesh, referenced: &[bool]) -> usize {
+    let nv = mesh.positions.len();
+    let mut comp = Dsu::new(nv);
+    for t in &mesh.triangles {
+        comp.union(t[0], t[1]);
+        comp.union(t[1], t[2]);
+    }
+    (0..nv as u32).filter(|&v| referenced[v as usize] && comp.find(v) == v).count()
+}
+
+/// Bounding box of the referenced vertices.
+fn referenced_bounding_box(mesh: &TriMesh, referenced: &[bool]) -> ([f64; 3], [f64; 3]) {
+    let mut bbox_min = [f64::INFINITY; 3];
+    let mut bbox_max = [f64::NEG_INFINITY; 3];
+    for (q, _) in mesh.positions.iter().zip(referenced).filter(|(_, &r)| r) {
+        for k in 0..3 {
+            bbox_min[k] = bbox_min[k].min(q[k]);
+            bbox_max[k] = bbox_max[k].max(q[k]);
+        }
+    }
+    (bbox_min, bbox_max)
+}
+
+/// Signed volume (the origin as reference point) and surface area.
+fn volume_and_area(mesh: &TriMesh, bbox_min: [f64; 3], bbox_max: [f64; 3]) -> (f64, f64) {
+    let p = &mesh.positions;
+    // Volume and area relative to the box centre, which keeps the determinants small.
+    let c = [0, 1, 2].map(|k| 0.5 * (bbox_min[k] + bbox_max[k]));
+    let mut volume = 0.0;
+    let mut area = 0.0;
+    let mut normal_sum = [0.0; 3];
+    for t in &mesh.triangles {
+        let [a, b, d] = t.map(|i| {
+            let q = p[i as usize];
+            [q[0] - c[0], q[1] - c[1], q[2] - c[2]]
+        });
+        let cross = [b[1] * d[2] - b[2] * d[1], b[2] * d[0] - b[0] * d[2], b[0] * d[1] - b[1] * d[0]];
+        volume += a[0] * cross[0] + a[1] * cross[1] + a[2] * cross[2];
+        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let e2 = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+        area += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        for k in 0..3 {
+            normal_sum[k] += n[k];
+        }
+    }
+    // Back to the origin as the reference point (trimesh's convention), exactly:
+    // det(a, b, d) = det(a', b', d') + c · ((b' − a') × (d' − a')) for a' = a − c.
+    // Σ N is zero on a closed mesh, so only open meshes, whose "volume" depends on the
+    // reference point anyway, are affected.
+    if !mesh.triangles.is_empty() {
+        volume += c[0] * normal_sum[0] + c[1] * normal_sum[1] + c[2] * normal_sum[2];
+    }
+    (volume / 6.0, area)
 }

@@ -10,7 +10,8 @@ use json::validation::Checked::Valid;
 use json::validation::USize64;
 
 use crate::atomic::{atomic_write, prepare};
-use crate::error::{ErrorKind, Location, MeshError};
+use crate::error::MeshError;
+use crate::output::OutputFormat;
 use crate::TriMesh;
 
 /// One mesh of a glTF scene: becomes one node with one triangle primitive.
@@ -36,22 +37,15 @@ pub enum GltfLayout {
 /// `.ply` (binary little-endian).
 ///
 /// # Errors
-/// [`ErrorKind::UnknownFormat`] for another extension; [`ErrorKind::Write`] when the file
-/// cannot be written (nothing is left behind).
+/// [`crate::ErrorKind::UnknownFormat`] for another extension ([`OutputFormat::from_path`]);
+/// [`crate::ErrorKind::Write`] when the file cannot be written (nothing is left behind).
 pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("glb") => write_gltf(path, &[SceneMesh { name: "mesh", mesh, colors: None }], GltfLayout::Binary),
-        Some("gltf") => write_gltf(path, &[SceneMesh { name: "mesh", mesh, colors: None }], GltfLayout::Separate),
-        Some("obj") => write_obj(path, mesh),
-        Some("ply") => write_ply(path, mesh),
-        _ => Err(MeshError::new(
-            ErrorKind::UnknownFormat,
-            path,
-            Location::File,
-            "the output extension names no format this program writes",
-        )
-        .hint("Use .glb, .gltf, .obj or .ply.")),
+    let scene = || [SceneMesh { name: "mesh", mesh, colors: None }];
+    match OutputFormat::from_path(path)? {
+        OutputFormat::Glb => write_gltf(path, &scene(), GltfLayout::Binary),
+        OutputFormat::Gltf => write_gltf(path, &scene(), GltfLayout::Separate),
+        OutputFormat::Obj => write_obj(path, mesh),
+        OutputFormat::Ply => write_ply(path, mesh),
     }
 }
 
@@ -220,7 +214,7 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
 /// triangle become empty nodes (an empty crust is a valid result, not an error).
 ///
 /// # Errors
-/// [`ErrorKind::Write`] when a file cannot be written; nothing partial is left.
+/// [`crate::ErrorKind::Write`] when a file cannot be written; nothing partial is left.
 pub fn write_gltf(path: &Path, meshes: &[SceneMesh], layout: GltfLayout) -> Result<(), MeshError> {
     let ser_err = |e: json::Error| MeshError::write(path, std::io::Error::other(e));
     match layout {

@@ -2,8 +2,10 @@
 //!
 //! `n` points uniform in the union of the two meshes' bounding boxes (seeded,
 //! [`occupancy::sample::uniform_in_box`]); a point is inside a mesh when its fast winding
-//! number (Barill et al. 2018 with the exact fallback near 0.5, [`occupancy::MeshOracle`])
-//! is at least 0.5, which is meaningful for open meshes and soups too. IoU = |inside
+//! number (Barill et al. 2018 with the exact fallback near ±0.5, [`occupancy::MeshOracle`])
+//! has magnitude at least 0.5 (the workspace's one rule,
+//! [`occupancy::Config::is_inside_winding`]), which is meaningful for open meshes, soups
+//! and inward-facing closed bodies too. IoU = |inside
 //! both| / |inside either|; `None` when no sample is inside either mesh.
 
 use mesh_io::TriMesh;
@@ -55,10 +57,10 @@ pub fn volumetric_iou(
     let (wr, wp) =
         rayon::join(|| ra.winding_numbers(&pts, WindingMode::Fast), || pa.winding_numbers(&pts, WindingMode::Fast));
     let (wr, wp) = (wr?, wp?);
-    let (tr, tp) = (ra.config().occupancy_threshold, pa.config().occupancy_threshold);
+    let (cr, cp) = (ra.config(), pa.config());
     let (mut a, mut b, mut both) = (0, 0, 0);
     for (x, y) in wr.iter().zip(&wp) {
-        let (ia, ib) = (*x >= tr, *y >= tp);
+        let (ia, ib) = (cr.is_inside_winding(*x), cp.is_inside_winding(*y));
         a += ia as usize;
         b += ib as usize;
         both += (ia && ib) as usize;

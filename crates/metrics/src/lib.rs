@@ -7,6 +7,8 @@
 //!   containing the true Hausdorff distance between the two surfaces, `hi − lo ≤ 1e-6 ×`
 //!   the bounding-box diagonal by default (branch and bound over triangle subdivisions with
 //!   BVH distance bounds, see [`hausdorff`]);
+//! - [`hausdorff_sphere_certified`]: the same kind of interval between a mesh and an
+//!   analytic [`mesh_io::shapes::Sphere`] (the sphere study's reference surface);
 //! - [`surface_metrics`]: Chamfer L1 and L2, F-score at τ (default 0.3% of the reference
 //!   diagonal), normal consistency on seeded area-weighted samples (100,000 per surface by
 //!   default), see [`surface`];
@@ -33,8 +35,8 @@ pub mod validity;
 pub use error::MetricsError;
 pub use eval::{evaluate, EvalOptions, EvalReport};
 pub use hausdorff::{
-    check_mesh, directed_hausdorff_certified, hausdorff_certified, hausdorff_libigl, CertifiedOptions, DistanceMesh,
-    HausdorffInterval,
+    check_mesh, directed_hausdorff_certified, hausdorff_certified, hausdorff_libigl, hausdorff_sphere_certified,
+    CertifiedOptions, DistanceMesh, HausdorffInterval, SphereInterval,
 };
 pub use iou::{volumetric_iou, IouResult};
 pub use surface::{surface_metrics, SurfaceMetrics, SurfaceOptions};

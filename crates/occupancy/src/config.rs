@@ -35,14 +35,17 @@ pub struct Config {
     /// 1.2e-3 and 3.5 about 6e-4 (see the crate README), so the default is 3.5.
     pub beta: f64,
     /// Exact fallback band of the fast winding number, in winding units (unitless). A query
-    /// whose fast value `w` satisfies `|w − occupancy_threshold| < exact_fallback_margin` is
-    /// recomputed exactly, so that the inside/outside decision never depends on the
+    /// whose fast value `w` satisfies `||w| − occupancy_threshold| < exact_fallback_margin`
+    /// (either side of either threshold ±`occupancy_threshold`) is recomputed exactly, so that the inside/outside decision never depends on the
     /// approximation as long as its error is below this margin (measured errors are below
     /// 1e-3; the margin leaves a factor of 20). Such points are rare (closed meshes have
     /// winding numbers near 0 or 1 almost everywhere) so this costs little. 0 disables it.
     pub exact_fallback_margin: f64,
-    /// Winding number at or above which a point counts as inside (unitless). 0.5 is the
-    /// usual choice for generalized winding numbers (Jacobson et al. 2013).
+    /// |Winding number| at or above which a point counts as inside (unitless), the one rule
+    /// of the workspace ([`Config::is_inside_winding`]). 0.5 is the usual choice for
+    /// generalized winding numbers (Jacobson et al. 2013); the absolute value makes a
+    /// closed body whose triangles all face inward (mirrored exports) count as solid, like
+    /// one facing outward. Must be in (0, 1].
     pub occupancy_threshold: f64,
     /// Relative padding of node boxes for the exact hierarchical winding number, as a
     /// fraction of the mesh bounding-box diagonal (unitless). The boundary-cap shortcut is
@@ -71,6 +74,22 @@ impl Default for Config {
 }
 
 impl Config {
+    /// The workspace's one inside/outside rule: a point with generalized winding number
+    /// `w` is inside when |w| ≥ `occupancy_threshold`. Sampling, training labels,
+    /// evaluation, IoU and `voronoi-fit query` all decide through this function (with
+    /// [`crate::MeshOracle::is_inside`] guarding the fast path on both sides of ±threshold).
+    #[inline]
+    pub fn is_inside_winding(&self, w: f64) -> bool {
+        w.abs() >= self.occupancy_threshold
+    }
+
+    /// Whether a fast winding number `w` is too close to ±`occupancy_threshold` to decide
+    /// inside/outside from the approximation: then it is recomputed exactly.
+    #[inline]
+    pub fn needs_exact_fallback(&self, w: f64) -> bool {
+        (w.abs() - self.occupancy_threshold).abs() < self.exact_fallback_margin
+    }
+
     /// Checks every field is in its documented range.
     ///
     /// # Errors
@@ -88,9 +107,9 @@ impl Config {
                 self.exact_fallback_margin
             )));
         }
-        if !self.occupancy_threshold.is_finite() {
+        if !(self.occupancy_threshold > 0.0 && self.occupancy_threshold <= 1.0) {
             return Err(OccupancyError::BadConfig(format!(
-                "occupancy_threshold = {} must be finite",
+                "occupancy_threshold = {} must be in (0, 1]",
                 self.occupancy_threshold
             )));
         }

@@ -56,7 +56,8 @@ pub struct MeshOracle {
 pub struct QueryBatch {
     /// #Q f64 generalized winding numbers.
     pub winding: Vec<f64>,
-    /// #Q u8 occupancy: 1 when `winding >= Config::occupancy_threshold`, else 0.
+    /// #Q u8 occupancy: 1 when |winding| ≥ `Config::occupancy_threshold`
+    /// ([`Config::is_inside_winding`]), else 0.
     pub occupancy: Vec<u8>,
     /// #Q f64 signed distances, mesh units: negative inside (occupancy 1), positive outside.
     pub sdf: Vec<f64>,
@@ -224,8 +225,9 @@ impl MeshOracle {
 
     /// Generalized winding number at `q`.
     ///
-    /// In [`WindingMode::Fast`], a value within `Config::exact_fallback_margin` of
-    /// `Config::occupancy_threshold` is recomputed exactly (counted in
+    /// In [`WindingMode::Fast`], a value whose magnitude is within
+    /// `Config::exact_fallback_margin` of `Config::occupancy_threshold` (either sign:
+    /// [`Config::needs_exact_fallback`]) is recomputed exactly (counted in
     /// `ws.num_exact_fallbacks`), so inside/outside never flips relative to the exact mode
     /// while the approximation error stays below the margin.
     ///
@@ -235,7 +237,7 @@ impl MeshOracle {
             WindingMode::Exact => self.winding_number_exact(q, ws),
             WindingMode::Fast => {
                 let w = self.winding_number_fast_unguarded(q, ws);
-                if (w - self.config.occupancy_threshold).abs() < self.config.exact_fallback_margin {
+                if self.config.needs_exact_fallback(w) {
                     ws.num_exact_fallbacks += 1;
                     self.winding_number_exact(q, ws)
                 } else {
@@ -245,9 +247,20 @@ impl MeshOracle {
         }
     }
 
-    /// Whether `q` is inside: winding number ≥ `Config::occupancy_threshold`.
+    /// Whether `q` is inside: |winding number| ≥ `Config::occupancy_threshold`
+    /// ([`Config::is_inside_winding`], the workspace's one rule).
     pub fn is_inside(&self, q: V3, mode: WindingMode, ws: &mut Workspace) -> bool {
-        self.winding_number(q, mode, ws) >= self.config.occupancy_threshold
+        self.config.is_inside_winding(self.winding_number(q, mode, ws))
+    }
+
+    /// [`MeshOracle::is_inside`] for many points, in parallel fixed-size chunks (fast mode
+    /// with the exact fallback): #Q booleans in query order.
+    ///
+    /// # Errors
+    /// A query that is not finite.
+    pub fn inside(&self, queries: &[V3]) -> Result<Vec<bool>, OccupancyError> {
+        validate_queries(queries)?;
+        Ok(self.map_coherent(queries, |q, ws| self.is_inside(q, WindingMode::Fast, ws)).0)
     }
 
     /// Closest point on the mesh to `q` (exact f64 point-triangle distances, BVH
@@ -317,7 +330,7 @@ impl MeshOracle {
             triangle: Vec::with_capacity(n),
         };
         for (w, c) in rows {
-            let inside = w >= self.config.occupancy_threshold;
+            let inside = self.config.is_inside_winding(w);
             let d = c.squared_distance.sqrt();
             out.winding.push(w);
             out.occupancy.push(inside as u8);

@@ -4,7 +4,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use soft_voronoi::kernel::{Kernel, SiteIndex};
 use soft_voronoi::losses;
-use soft_voronoi::train::paper_init;
+use soft_voronoi::init::paper_init;
 
 fn bench(c: &mut Criterion) {
     let (sites, labels) = paper_init(4096, 1);

@@ -21,8 +21,9 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use ndarray::{Array1, Array2};
-use ndarray_npy::{NpzReader, NpzWriter};
+use ndarray::Array2;
+use ndarray_npy::NpzReader;
+use vf_common::npz::NpzOut;
 
 use crate::error::TrainError;
 use crate::losses::{Located, SiteGraph};
@@ -31,10 +32,6 @@ use crate::train::{StepStats, TrainState};
 /// The checkpoint format version.
 pub const FORMAT_VERSION: i64 = 1;
 
-fn rows(v: &[[f64; 3]]) -> Array2<f64> {
-    Array2::from_shape_vec((v.len(), 3), v.iter().flatten().copied().collect()).expect("n×3")
-}
-
 /// Writes `state` and the caller's `context_json` to `path` atomically (temporary file
 /// beside it, then rename).
 ///
@@ -42,29 +39,27 @@ fn rows(v: &[[f64; 3]]) -> Array2<f64> {
 /// [`TrainError::Checkpoint`] when the file cannot be written.
 pub fn write(path: &Path, state: &TrainState, context_json: &str) -> Result<(), TrainError> {
     let fail = |message: String| TrainError::Checkpoint { path: path.display().to_string(), message };
-    let enc = |e: ndarray_npy::WriteNpzError| fail(format!("cannot encode ({e})"));
-    let mut w = NpzWriter::new(Cursor::new(Vec::new()));
     let config = serde_json::to_string(&state.config).map_err(|e| fail(e.to_string()))?;
-    w.add_array("format_version", &Array1::from(vec![FORMAT_VERSION])).map_err(enc)?;
-    w.add_array("config_json", &Array1::from(config.into_bytes())).map_err(enc)?;
-    w.add_array("context_json", &Array1::from(context_json.as_bytes().to_vec())).map_err(enc)?;
-    w.add_array("step", &Array1::from(vec![state.step as u64])).map_err(enc)?;
-    w.add_array("sites", &rows(&state.sites)).map_err(enc)?;
-    w.add_array("labels", &Array1::from(state.labels.iter().map(|&b| b as u8).collect::<Vec<u8>>())).map_err(enc)?;
-    w.add_array("adam_m", &rows(&state.m)).map_err(enc)?;
-    w.add_array("adam_v", &rows(&state.v)).map_err(enc)?;
-    w.add_array("graph_offsets", &Array1::from(state.graph.offsets.clone())).map_err(enc)?;
-    w.add_array("graph_neighbors", &Array1::from(state.graph.neighbors.clone())).map_err(enc)?;
-    w.add_array("located_inside", &Array1::from(state.located.iter().map(|l| l.inside as u8).collect::<Vec<u8>>()))
-        .map_err(enc)?;
     let closest: Vec<[f64; 3]> = state.located.iter().map(|l| l.closest).collect();
-    w.add_array("located_closest", &rows(&closest)).map_err(enc)?;
     let hist: Vec<f64> = state.history.iter().flat_map(|s| s.to_row()).collect();
-    w.add_array("history", &Array2::from_shape_vec((state.history.len(), StepStats::COLUMNS), hist).expect("S×9"))
-        .map_err(enc)?;
-    w.add_array("data_fingerprint", &Array1::from(vec![state.data_fingerprint])).map_err(enc)?;
-    let bytes = w.finish().map_err(enc)?.into_inner();
-    mesh_io::atomic_write(path, |out| out.write_all(&bytes)).map_err(|e| fail(e.to_string()))
+    let hist = Array2::from_shape_vec((state.history.len(), StepStats::COLUMNS), hist).expect("S×9");
+    let mut w = NpzOut::new();
+    w.add_vec("format_version", vec![FORMAT_VERSION])
+        .and_then(|w| w.add_vec("config_json", config.into_bytes()))
+        .and_then(|w| w.add_vec("context_json", context_json.as_bytes().to_vec()))
+        .and_then(|w| w.add_vec("step", vec![state.step as u64]))
+        .and_then(|w| w.add_rows("sites", &state.sites))
+        .and_then(|w| w.add_vec("labels", state.labels.iter().map(|&b| b as u8).collect::<Vec<u8>>()))
+        .and_then(|w| w.add_rows("adam_m", &state.m))
+        .and_then(|w| w.add_rows("adam_v", &state.v))
+        .and_then(|w| w.add_vec("graph_offsets", state.graph.offsets.clone()))
+        .and_then(|w| w.add_vec("graph_neighbors", state.graph.neighbors.clone()))
+        .and_then(|w| w.add_vec("located_inside", state.located.iter().map(|l| l.inside as u8).collect::<Vec<u8>>()))
+        .and_then(|w| w.add_rows("located_closest", &closest))
+        .and_then(|w| w.add("history", &hist))
+        .and_then(|w| w.add_vec("data_fingerprint", vec![state.data_fingerprint]))
+        .map_err(|e| fail(e.to_string()))?;
+    w.write(path).map_err(|e| fail(e.to_string()))
 }
 
 /// Reads a checkpoint: the state and the caller's context JSON.

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::adam::AdamParams;
+use vf_common::AdamParams;
 use crate::error::TrainError;
 
 /// How the sites start.
@@ -17,7 +17,7 @@ pub enum Init {
     /// half the sites start next to the surface, on its correct side.
     Samples,
     /// Pairs of sites straddling the surface at random surface points, one on each side
-    /// along the normal, labelled by the solid (see [`crate::train::surface_init`]).
+    /// along the normal, labelled by the solid (see [`crate::init::surface_init`]).
     Surface,
 }
 
@@ -143,7 +143,7 @@ impl TrainConfig {
     /// a full m×m grid on each of the 6 faces.
     pub fn num_boundary(&self) -> usize {
         let want = self.boundary_sites.unwrap_or_else(|| (self.num_sites as f64).sqrt().ceil() as usize);
-        crate::train::boundary_grid_size(want).map_or(0, |m| 6 * m * m)
+        crate::init::boundary_grid_size(want).map_or(0, |m| 6 * m * m)
     }
 
     /// Learning rate at 0-based step `t`: cosine from `lr` to `lr_final`.
@@ -210,10 +210,7 @@ impl TrainConfig {
         if self.refresh_every == 0 {
             return bad("refresh_every must be >= 1".into());
         }
-        let a = &self.adam;
-        if !((0.0..1.0).contains(&a.beta1) && (0.0..1.0).contains(&a.beta2) && pos(a.eps)) {
-            return bad(format!("Adam constants {a:?} must have 0 <= beta1, beta2 < 1 and eps > 0"));
-        }
+        self.adam.validate().map_err(TrainError::Config)?;
         Ok(())
     }
 }

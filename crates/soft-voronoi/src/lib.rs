@@ -4,7 +4,7 @@
 //! A shape is K sites in the unit cube with fixed inside/outside labels, plus fixed outside
 //! sites on the cube's faces. Its occupancy is the label of the nearest site; training
 //! replaces the argmin by a softmax of −β·distance ([`kernel`]) and moves the sites with
-//! Adam ([`adam`]) on four losses ([`losses`]): reconstruction E|O − V|, bounds, signed
+//! Adam (`vf_common::adam`) on four losses ([`losses`]): reconstruction E|O − V|, bounds, signed
 //! distance of each site to its side of the surface, and centroidal ‖L p‖² on the
 //! Delaunay graph of the sites. [`Trainer`] runs it step by step and [`checkpoint`] saves
 //! and restores its state bit-exactly.
@@ -12,19 +12,21 @@
 //! The kernel is sparse: a k-d tree over the sites (kiddo) gives each sample its nearest
 //! site and the few sites within τ/β of it, instead of the dense N×K softmax.
 
-pub mod adam;
 pub mod checkpoint;
 pub mod config;
+pub mod data;
 pub mod dense;
 pub mod error;
+pub mod init;
 pub mod kernel;
 pub mod losses;
 pub mod solid;
 pub mod train;
 
 pub use config::{Init, TrainConfig, Weights};
+pub use vf_common::AdamParams;
 pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};
-pub use solid::{inside_winding, MeshSolid, Sphere};
+pub use solid::{MeshSolid, Sphere};
 pub use train::{classify, soft_values, StepStats, TrainState, Trainer, TrainingData};

@@ -1,7 +1,7 @@
 //! The sparse soft-Voronoi kernel against the dense f64 reference, finite differences and
 //! extreme inputs.
 
-use occupancy::sample::rng::ChunkRng;
+use vf_common::rng::{ChunkRng, Stream};
 use soft_voronoi::kernel::{self, Kernel, Scratch, SiteIndex};
 use soft_voronoi::{dense, losses};
 
@@ -10,7 +10,7 @@ const BETAS: [f64; 6] = [10.0, 100.0, 1_000.0, 10_000.0, 30_000.0, 100_000.0];
 /// Random sites, labels, and query points of which half sit near a bisector of two sites
 /// (where the soft-argmin is not saturated and the gradient is large).
 fn config(k: usize, n: usize, beta: f64, seed: u64) -> (Vec<[f64; 3]>, Vec<bool>, Vec<[f64; 3]>) {
-    let mut rng = ChunkRng::for_chunk(seed, 7, 0);
+    let mut rng = ChunkRng::for_chunk(seed, Stream::Test, 7);
     let sites: Vec<[f64; 3]> = (0..k).map(|_| [rng.uniform(), rng.uniform(), rng.uniform()]).collect();
     let labels: Vec<bool> = (0..k).map(|_| rng.next_u64() % 2 == 0).collect();
     let index = SiteIndex::new(&sites);

@@ -2,7 +2,7 @@
 //! thread-count independence, and that training on a sphere improves the fit and leaves a
 //! watertight crust.
 
-use occupancy::sample::rng::ChunkRng;
+use vf_common::rng::{ChunkRng, Stream};
 use soft_voronoi::losses::{self, SiteGraph, Solid};
 use soft_voronoi::{checkpoint, classify, Init, Sphere, TrainConfig, TrainError, TrainState, Trainer, TrainingData};
 
@@ -11,7 +11,7 @@ const SPHERE: Sphere = Sphere { center: [0.5, 0.5, 0.5], radius: 0.35 };
 /// Uniform and near-surface samples of the sphere, labelled analytically, with surface
 /// points and normals.
 fn sphere_data(n: usize, seed: u64) -> TrainingData {
-    let mut rng = ChunkRng::for_chunk(seed, 11, 0);
+    let mut rng = ChunkRng::for_chunk(seed, Stream::Test, 11);
     let mut points = Vec::with_capacity(n);
     let mut surface = Vec::new();
     let mut normals = Vec::new();
@@ -155,7 +155,7 @@ fn training_improves_the_sphere_and_the_crust_is_watertight() {
 }
 
 fn random_sites(n: usize, seed: u64) -> Vec<[f64; 3]> {
-    let mut rng = ChunkRng::for_chunk(seed, 12, 0);
+    let mut rng = ChunkRng::for_chunk(seed, Stream::Test, 12);
     (0..n).map(|_| [rng.uniform(), rng.uniform(), rng.uniform()]).collect()
 }
 

@@ -311,20 +311,22 @@ fn read_primitive(
         let b = pdata.get(i);
         let c = |k: usize| f32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]]) as f64;
         let p = [c(0), c(1), c(2)];
-        if p.iter().any(|v| !v.is_finite()) {
-            return Err(MeshError::new(
-                ErrorKind::NonFinite,
-                path,
-                Location::Element { kind: "accessor", index: pos.index() },
-                format!("POSITION element {i} of accessor {} is {p:?}, not finite", pos.index()),
-            ));
+        let location = Location::Element { kind: "accessor", index: pos.index() };
+        if let Some(axis) = p.iter().position(|v| !v.is_finite()) {
+            let what = format!("POSITION element {i} of accessor {}", pos.index());
+            return Err(crate::limits::coordinate_error(path, location, &what, axis, p[axis]));
         }
         let w = world;
-        mesh.positions.push([
+        let q = [
             w[0][0] * p[0] + w[1][0] * p[1] + w[2][0] * p[2] + w[3][0],
             w[0][1] * p[0] + w[1][1] * p[1] + w[2][1] * p[2] + w[3][1],
             w[0][2] * p[0] + w[1][2] * p[1] + w[2][2] * p[2] + w[3][2],
-        ]);
+        ];
+        if let Some((axis, value)) = crate::limits::out_of_range(&q) {
+            let what = format!("POSITION element {i} of accessor {} (after the node transforms)", pos.index());
+            return Err(crate::limits::coordinate_error(path, location, &what, axis, value));
+        }
+        mesh.positions.push(q);
     }
 
     let indices: Vec<u32> = match prim.indices() {

@@ -2,8 +2,9 @@
 //!
 //! Every reader reports problems with the file name and a line (text formats) or an element
 //! index / byte offset (binary formats). The shared checks after parsing (finite
-//! coordinates, indices in range, at least one triangle) run in [`finish`] so that no
-//! format can skip them; readers also check as they go, to name the line.
+//! coordinates within the representable range of [`crate::limits`], indices in range, at
+//! least one triangle) run in [`finish`] so that no format can skip them; readers also
+//! check as they go, to name the line.
 
 mod gltf;
 mod obj;
@@ -77,7 +78,9 @@ fn trim_ascii_start(b: &[u8]) -> &[u8] {
 /// # Errors
 /// A [`MeshError`] naming the file and the line or element, for unreadable files,
 /// unknown formats, syntax errors, truncated binaries, NaN or infinite coordinates,
-/// out-of-range indices, unsupported features and meshes without a triangle.
+/// coordinates outside the representable range ([`crate::check_representable`]: beyond
+/// ±1e30, or a mesh spanning less than 1e-30), out-of-range indices, unsupported features
+/// and meshes without a triangle.
 ///
 /// # Example
 /// ```
@@ -122,16 +125,25 @@ pub fn read_mesh_from_bytes(bytes: &[u8], path: &Path) -> std::result::Result<Tr
     finish(raw, path)
 }
 
-/// Shared checks after parsing, then exact welding.
+/// Shared checks after parsing (finite and representable coordinates, indices in range, at
+/// least one triangle), then exact welding.
 pub(crate) fn finish(mesh: TriMesh, path: &Path) -> Result<TriMesh> {
-    if let Some(i) = mesh.positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+    check_contents(&mesh, path)?;
+    if mesh.triangles.is_empty() {
         return Err(MeshError::new(
-            ErrorKind::NonFinite,
+            ErrorKind::Empty,
             path,
-            Location::Element { kind: "vertex", index: i },
-            format!("vertex {i} has a coordinate that is NaN or infinite: {:?}", mesh.positions[i]),
+            Location::File,
+            format!("the file holds no triangle ({} vertices, 0 faces)", mesh.positions.len()),
         ));
     }
+    Ok(weld_exact(&mesh))
+}
+
+/// Every coordinate finite and within the representable range, every index in range;
+/// vertices are named by their index in `mesh.positions` (before welding).
+pub(crate) fn check_contents(mesh: &TriMesh, path: &Path) -> Result<()> {
+    crate::limits::check_representable(mesh, path)?;
     let n = mesh.positions.len();
     for (f, t) in mesh.triangles.iter().enumerate() {
         if let Some(&bad) = t.iter().find(|&&i| i as usize >= n) {
@@ -143,15 +155,7 @@ pub(crate) fn finish(mesh: TriMesh, path: &Path) -> Result<TriMesh> {
             ));
         }
     }
-    if mesh.triangles.is_empty() {
-        return Err(MeshError::new(
-            ErrorKind::Empty,
-            path,
-            Location::File,
-            format!("the file holds no triangle ({} vertices, 0 faces)", mesh.positions.len()),
-        ));
-    }
-    Ok(weld_exact(&mesh))
+    Ok(())
 }
 
 /// Triangulate a polygon given by its vertex ids as a fan around its first vertex.

@@ -1,8 +1,9 @@
 //! Wavefront OBJ through `tobj`, with the checks tobj leaves out.
 //!
 //! tobj parses and triangulates; it accepts empty files, garbage and NaN coordinates, and
-//! its errors carry no line number. After it, this module checks finiteness and emptiness,
-//! and on any problem scans the text once more to name the offending line.
+//! its errors carry no line number. After it, this module checks finiteness, the
+//! representable range and emptiness, and on any problem scans the text once more to name
+//! the offending line.
 
 use std::path::Path;
 
@@ -42,8 +43,9 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
             mesh.triangles.push([t[0] + base as u32, t[1] + base as u32, t[2] + base as u32]);
         }
     }
-    if mesh.positions.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
-        return Err(locate(bytes, path, "a vertex coordinate is NaN or infinite"));
+    if mesh.positions.iter().any(|p| crate::limits::out_of_range(p).is_some()) {
+        // The scan names the line: parse_point checks finiteness and the range.
+        return Err(locate(bytes, path, "a vertex coordinate is NaN, infinite or beyond ±1e30"));
     }
     if mesh.triangles.is_empty() {
         // tobj drops faces with fewer than three corners silently: name such a line if

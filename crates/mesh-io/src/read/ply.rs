@@ -67,7 +67,57 @@ enum Encoding {
 }
 
 pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
-    let (encoding, elements, body_start, header_lines) = parse_header(bytes, path)?;
+    let header = parse_header(bytes, path)?;
+    let layout = Layout::of(&header.elements, path)?;
+    let mut reader: Box<dyn Values + '_> = match header.encoding {
+        Encoding::Ascii => Box::new(AsciiValues::new(bytes, header.body_start, header.lines)),
+        Encoding::Little | Encoding::Big => {
+            Box::new(BinaryValues { bytes, pos: header.body_start, big: header.encoding == Encoding::Big })
+        }
+    };
+    let remaining = bytes.len() - header.body_start.min(bytes.len());
+    let mut body = Body { layout, mesh: TriMesh::default(), poly: Vec::new() };
+    for (ei, el) in header.elements.iter().enumerate() {
+        check_count_fits(el, remaining, path)?;
+        if ei == body.layout.vertex {
+            super::check_vertex_count(el.count, path)?;
+            body.mesh.positions.reserve(el.count);
+        }
+        for i in 0..el.count {
+            body.read_instance(reader.as_mut(), el, ei, i, path)?;
+        }
+    }
+    Ok(body.mesh)
+}
+
+/// Where the geometry is among the header's elements and properties.
+struct Layout {
+    /// Index of the `vertex` element.
+    vertex: usize,
+    /// Indices of the x, y, z properties within it.
+    xyz: [usize; 3],
+    /// Index of the `face` element and of its vertex-index list property, if any.
+    face: Option<(usize, usize)>,
+}
+
+impl Layout {
+    fn of(elements: &[Element], path: &Path) -> Result<Layout> {
+        let (vertex, xyz) = vertex_layout(elements, path)?;
+        let face = face_layout(elements, path)?;
+        if face.is_some_and(|(f, _)| f < vertex) {
+            return Err(MeshError::new(
+                ErrorKind::Unsupported,
+                path,
+                Location::File,
+                "the `face` element comes before the `vertex` element",
+            ));
+        }
+        Ok(Layout { vertex, xyz, face })
+    }
+}
+
+/// The `vertex` element and its scalar properties x, y, z.
+fn vertex_layout(elements: &[Element], path: &Path) -> Result<(usize, [usize; 3])> {
     let vertex = elements.iter().position(|e| e.name == "vertex").ok_or_else(|| {
         MeshError::new(ErrorKind::Syntax, path, Location::File, "the header declares no `vertex` element")
     })?;
@@ -90,142 +140,147 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
             "the `vertex` element lacks one of the scalar properties x, y, z",
         ));
     };
-    let face = elements.iter().position(|e| e.name == "face");
-    if face.is_none() && elements.iter().any(|e| e.name == "tristrips") {
-        return Err(MeshError::new(
-            ErrorKind::Unsupported,
-            path,
-            Location::File,
-            "the file stores triangle strips (`tristrips`), not faces",
-        ));
-    }
-    let face_prop = match face {
-        Some(f) => Some(
-            elements[f]
-                .props
-                .iter()
-                .position(
-                    |p| matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index"),
-                )
-                .ok_or_else(|| {
-                    MeshError::new(
-                        ErrorKind::Syntax,
-                        path,
-                        Location::File,
-                        "the `face` element has no list property `vertex_indices`",
-                    )
-                })?,
-        ),
-        None => None,
-    };
-
-    if face.is_some_and(|f| f < vertex) {
-        return Err(MeshError::new(
-            ErrorKind::Unsupported,
-            path,
-            Location::File,
-            "the `face` element comes before the `vertex` element",
-        ));
-    }
-    let mut mesh = TriMesh::default();
-    let mut reader: Box<dyn Values + '_> = match encoding {
-        Encoding::Ascii => Box::new(AsciiValues::new(bytes, body_start, header_lines)),
-        Encoding::Little | Encoding::Big => {
-            Box::new(BinaryValues { bytes, pos: body_start, big: encoding == Encoding::Big })
-        }
-    };
-    let mut poly: Vec<u32> = Vec::new();
-    for (ei, el) in elements.iter().enumerate() {
-        // Refuse counts the remaining bytes cannot hold (at least one byte per element
-        // per property), before allocating for them.
-        let min_bytes = el.count.saturating_mul(el.props.len().max(1));
-        if el.count > 0 && min_bytes > bytes.len() - body_start.min(bytes.len()) {
-            return Err(MeshError::new(
-                ErrorKind::Truncated,
-                path,
-                Location::File,
-                format!(
-                    "the header announces {} `{}` elements, more than the {} bytes after the header can hold",
-                    el.count,
-                    el.name,
-                    bytes.len() - body_start.min(bytes.len())
-                ),
-            ));
-        }
-        if ei == vertex {
-            super::check_vertex_count(el.count, path)?;
-            mesh.positions.reserve(el.count);
-        }
-        for i in 0..el.count {
-            reader.start_element(&el.name, i, path)?;
-            let mut p = [0.0; 3];
-            for (k, prop) in el.props.iter().enumerate() {
-                match prop {
-                    Property::Scalar { ty, .. } => {
-                        let v = reader.scalar(*ty, &el.name, i, path)?;
-                        if ei == vertex {
-                            if k == px {
-                                p[0] = v;
-                            } else if k == py {
-                                p[1] = v;
-                            } else if k == pz {
-                                p[2] = v;
-                            }
-                        }
-                    }
-                    Property::List { count, item, .. } => {
-                        let n = reader.scalar(*count, &el.name, i, path)?;
-                        if !(0.0..=1.0e6).contains(&n) || n.fract() != 0.0 {
-                            return Err(reader.error(
-                                &el.name,
-                                i,
-                                path,
-                                &format!("list length {n} is not a whole number between 0 and 1,000,000"),
-                            ));
-                        }
-                        let is_faces = Some(ei) == face && Some(k) == face_prop;
-                        poly.clear();
-                        for _ in 0..n as usize {
-                            let v = reader.scalar(*item, &el.name, i, path)?;
-                            if is_faces {
-                                if v < 0.0 || v.fract() != 0.0 || v >= mesh.positions.len() as f64 {
-                                    return Err(MeshError::new(
-                                        ErrorKind::IndexOutOfRange,
-                                        path,
-                                        reader.location(&el.name, i),
-                                        format!(
-                                            "face {i} refers to vertex {v} but the file has {} vertices",
-                                            mesh.positions.len()
-                                        ),
-                                    ));
-                                }
-                                poly.push(v as u32);
-                            }
-                        }
-                        if is_faces {
-                            super::fan(&poly, &mut mesh.triangles);
-                        }
-                    }
-                }
-            }
-            reader.end_element(&el.name, i, path)?;
-            if ei == vertex {
-                if p.iter().any(|c| !c.is_finite()) {
-                    return Err(MeshError::new(
-                        ErrorKind::NonFinite,
-                        path,
-                        reader.location(&el.name, i),
-                        format!("vertex {i} is {p:?}, not finite"),
-                    ));
-                }
-                mesh.positions.push(p);
-            }
-        }
-    }
-    Ok(mesh)
+    Ok((vertex, [px, py, pz]))
 }
 
-type Header = (Encoding, Vec<Element>, usize, usize);
+/// The `face` element and its list property `vertex_indices` (or `vertex_index`), if the
+/// file has faces; triangle strips are refused.
+fn face_layout(elements: &[Element], path: &Path) -> Result<Option<(usize, usize)>> {
+    let Some(face) = elements.iter().position(|e| e.name == "face") else {
+        if elements.iter().any(|e| e.name == "tristrips") {
+            return Err(MeshError::new(
+                ErrorKind::Unsupported,
+                path,
+                Location::File,
+                "the file stores triangle strips (`tristrips`), not faces",
+            ));
+        }
+        return Ok(None);
+    };
+    let prop = elements[face]
+        .props
+        .iter()
+        .position(|p| matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index"))
+        .ok_or_else(|| {
+            MeshError::new(
+                ErrorKind::Syntax,
+                path,
+                Location::File,
+                "the `face` element has no list property `vertex_indices`",
+            )
+        })?;
+    Ok(Some((face, prop)))
+}
+
+/// Refuse counts the remaining bytes cannot hold (at least one byte per element per
+/// property), before allocating for them.
+fn check_count_fits(el: &Element, remaining: usize, path: &Path) -> Result<()> {
+    let min_bytes = el.count.saturating_mul(el.props.len().max(1));
+    if el.count > 0 && min_bytes > remaining {
+        return Err(MeshError::new(
+            ErrorKind::Truncated,
+            path,
+            Location::File,
+            format!(
+                "the header announces {} `{}` elements, more than the {remaining} bytes after the header can hold",
+                el.count, el.name
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The mesh being read, with the layout that says which values are geometry.
+struct Body {
+    layout: Layout,
+    mesh: TriMesh,
+    /// The current face's vertex ids (reused).
+    poly: Vec<u32>,
+}
+
+impl Body {
+    /// Read instance `i` of element `el` (the `ei`-th), keeping vertices and faces.
+    fn read_instance(&mut self, reader: &mut dyn Values, el: &Element, ei: usize, i: usize, path: &Path) -> Result<()> {
+        reader.start_element(&el.name, i, path)?;
+        let is_vertex = ei == self.layout.vertex;
+        let mut p = [0.0; 3];
+        for (k, prop) in el.props.iter().enumerate() {
+            match prop {
+                Property::Scalar { ty, .. } => {
+                    let v = reader.scalar(*ty, &el.name, i, path)?;
+                    if let Some(axis) = self.layout.xyz.iter().position(|&x| is_vertex && x == k) {
+                        p[axis] = v;
+                    }
+                }
+                Property::List { count, item, .. } => {
+                    let is_faces = self.layout.face == Some((ei, k));
+                    self.read_list(reader, (*count, *item), el, i, is_faces, path)?;
+                }
+            }
+        }
+        reader.end_element(&el.name, i, path)?;
+        if is_vertex {
+            if let Some((axis, value)) = crate::limits::out_of_range(&p) {
+                let location = reader.location(&el.name, i);
+                return Err(crate::limits::coordinate_error(path, location, &format!("vertex {i}"), axis, value));
+            }
+            self.mesh.positions.push(p);
+        }
+        Ok(())
+    }
+
+    /// Read one list value; for the faces' vertex indices, check them and add the polygon
+    /// as a fan of triangles.
+    fn read_list(
+        &mut self,
+        reader: &mut dyn Values,
+        (count, item): (Scalar, Scalar),
+        el: &Element,
+        i: usize,
+        is_faces: bool,
+        path: &Path,
+    ) -> Result<()> {
+        let n = reader.scalar(count, &el.name, i, path)?;
+        if !(0.0..=1.0e6).contains(&n) || n.fract() != 0.0 {
+            return Err(reader.error(
+                &el.name,
+                i,
+                path,
+                &format!("list length {n} is not a whole number between 0 and 1,000,000"),
+            ));
+        }
+        self.poly.clear();
+        let num_positions = self.mesh.positions.len();
+        for _ in 0..n as usize {
+            let v = reader.scalar(item, &el.name, i, path)?;
+            if !is_faces {
+                continue;
+            }
+            if v < 0.0 || v.fract() != 0.0 || v >= num_positions as f64 {
+                return Err(MeshError::new(
+                    ErrorKind::IndexOutOfRange,
+                    path,
+                    reader.location(&el.name, i),
+                    format!("face {i} refers to vertex {v} but the file has {num_positions} vertices"),
+                ));
+            }
+            self.poly.push(v as u32);
+        }
+        if is_faces {
+            super::fan(&self.poly, &mut self.mesh.triangles);
+        }
+        Ok(())
+    }
+}
+
+/// What the header says: encoding, elements, where the body starts and how many lines the
+/// header has.
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    body_start: usize,
+    lines: usize,
+}
 
 fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let mut pos = 0usize;
@@ -284,7 +339,7 @@ fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     }
     let encoding = encoding
         .ok_or_else(|| MeshError::new(ErrorKind::Syntax, path, Location::File, "the header has no `format` line"))?;
-    Ok((encoding, elements, pos, line_no))
+    Ok(Header { encoding, elements, body_start: pos, lines: line_no })
 }
 
 /// A source of property values, ASCII or binary.

@@ -56,13 +56,10 @@ fn read_binary(bytes: &[u8], count: usize, path: &Path) -> Result<TriMesh> {
         for c in 0..3 {
             let o = 12 + 12 * c;
             let p = [f(o), f(o + 4), f(o + 8)];
-            if p.iter().any(|v| !v.is_finite()) {
-                return Err(MeshError::new(
-                    ErrorKind::NonFinite,
-                    path,
-                    Location::Element { kind: "triangle", index: t },
-                    format!("corner {c} of triangle {t} is {p:?}, not finite (byte {})", 84 + 50 * t + o),
-                ));
+            if let Some((axis, value)) = crate::limits::out_of_range(&p) {
+                let what = format!("corner {c} of triangle {t} (byte {})", 84 + 50 * t + o + 4 * axis);
+                let location = Location::Element { kind: "triangle", index: t };
+                return Err(crate::limits::coordinate_error(path, location, &what, axis, value));
             }
             mesh.positions.push(p);
         }

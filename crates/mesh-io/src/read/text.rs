@@ -38,11 +38,13 @@ pub(crate) fn parse_f64(tok: Option<&str>, path: &Path, line: usize, what: &str)
         MeshError::new(ErrorKind::Syntax, path, Location::Line(line), format!("expected {what}, found {tok:?}"))
     })?;
     if !v.is_finite() {
+        // A 400-digit overflow prints as `inf`, not as itself.
+        let shown = if tok.len() <= 24 { format!("{tok:?}") } else { crate::limits::short(v) };
         return Err(MeshError::new(
             ErrorKind::NonFinite,
             path,
             Location::Line(line),
-            format!("{what} is {tok:?}, not a finite number"),
+            format!("{what} is {shown}, not a finite number"),
         ));
     }
     Ok(v)
@@ -68,11 +70,16 @@ pub(crate) fn parse_usize(tok: Option<&str>, path: &Path, line: usize, what: &st
     })
 }
 
-/// Three coordinates from a token iterator.
+/// Three coordinates from a token iterator, each finite and within the representable
+/// range of [`crate::limits`].
 pub(crate) fn parse_point<'a>(toks: &mut impl Iterator<Item = &'a str>, path: &Path, line: usize) -> Result<[f64; 3]> {
-    Ok([
+    let p = [
         parse_f64(toks.next(), path, line, "an x coordinate")?,
         parse_f64(toks.next(), path, line, "a y coordinate")?,
         parse_f64(toks.next(), path, line, "a z coordinate")?,
-    ])
+    ];
+    if let Some((axis, value)) = crate::limits::out_of_range(&p) {
+        return Err(crate::limits::coordinate_error(path, Location::Line(line), "the vertex", axis, value));
+    }
+    Ok(p)
 }

@@ -11,14 +11,11 @@ use rayon::prelude::*;
 
 use crate::vec3::{add, cross, dot, scale, sub, V3};
 use crate::OccupancyError;
-use rng::ChunkRng;
+use rng::{ChunkRng, Stream};
 
 /// Points per sampling chunk (fixed: part of the definition of the sample sequence).
 pub const SAMPLE_CHUNK: usize = 4096;
 
-const STREAM_UNIFORM: u64 = 1;
-const STREAM_SURFACE: u64 = 2;
-const STREAM_NEAR: u64 = 3;
 
 /// `n` points uniform in the box `[lo, hi]`.
 ///
@@ -34,7 +31,7 @@ pub fn uniform_in_box(lo: V3, hi: V3, n: usize, seed: u64) -> Result<Vec<V3>, Oc
     let ext = sub(hi, lo);
     let mut out = vec![[0.0; 3]; n];
     out.par_chunks_mut(SAMPLE_CHUNK).enumerate().for_each(|(c, chunk)| {
-        let mut rng = ChunkRng::for_chunk(seed, STREAM_UNIFORM, c as u64);
+        let mut rng = ChunkRng::for_chunk(seed, Stream::SampleUniform, c as u64);
         for p in chunk {
             for k in 0..3 {
                 p[k] = lo[k] + ext[k] * rng.uniform();
@@ -128,7 +125,7 @@ impl SurfaceSampler {
     pub fn sample(&self, n: usize, seed: u64) -> SurfaceSamples {
         let mut rows = vec![([0.0; 3], [0.0; 3], 0u32); n];
         rows.par_chunks_mut(SAMPLE_CHUNK).enumerate().for_each(|(c, chunk)| {
-            let mut rng = ChunkRng::for_chunk(seed, STREAM_SURFACE, c as u64);
+            let mut rng = ChunkRng::for_chunk(seed, Stream::SampleSurface, c as u64);
             for r in chunk {
                 *r = self.draw(&mut rng);
             }
@@ -160,7 +157,7 @@ pub fn near_surface(sampler: &SurfaceSampler, n: usize, sigmas: &[f64], seed: u6
     let k = sigmas.len();
     let mut out = vec![[0.0; 3]; n];
     out.par_chunks_mut(SAMPLE_CHUNK).enumerate().for_each(|(c, chunk)| {
-        let mut rng = ChunkRng::for_chunk(seed, STREAM_NEAR, c as u64);
+        let mut rng = ChunkRng::for_chunk(seed, Stream::SampleNearSurface, c as u64);
         for (j, p) in chunk.iter_mut().enumerate() {
             let i = c * SAMPLE_CHUNK + j;
             let sigma = sigmas[((i as u128 * k as u128) / n as u128) as usize];

@@ -1,0 +1,17 @@
+//! Helpers that several voronoi-fit crates need, each with one home:
+//!
+//! - [`rng`]: SplitMix64 and xoshiro256++ generators and the table of named random
+//!   streams ([`rng::Stream`]) every crate draws from, so no two places pick the same
+//!   number by hand;
+//! - [`adam`]: the Adam optimiser's settings and update, used by the soft-Voronoi
+//!   trainer (f64 sites) and the MLP baselines (f32/f64 weights);
+//! - [`npz`] (feature `npz`, on by default): an uncompressed `.npz` built in memory and
+//!   written atomically (sites files, checkpoints, CLI outputs).
+
+pub mod adam;
+#[cfg(feature = "npz")]
+pub mod npz;
+pub mod rng;
+
+pub use adam::AdamParams;
+pub use rng::{ChunkRng, SplitMix64, Stream};

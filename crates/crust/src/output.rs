@@ -1,0 +1,283 @@
+//! The crust as written: mapped to the mesh frame, rounded as the file stores it, and
+//! checked exactly in that form.
+//!
+//! [`Crust::extract`](crate::Crust::extract) checks the crust in the unit cube, in f64.
+//! A file holds something else: the positions mapped back to the input's frame and
+//! rounded to the format's floats (f32 for GLB / glTF, f64 for OBJ and PLY as
+//! `mesh_io` writes them), read back by software that welds bitwise-equal positions.
+//! Rounding can make distinct vertices coincide (degenerate triangles, pinched vertices,
+//! open edges after welding) or move them so that triangles cross, and split vertices
+//! (inside cells touching along an edge or at a point share a position) weld into
+//! non-manifold vertices. [`finalize`] produces the mesh exactly as it will be written and
+//! read, repairs it where rounding broke it, and checks it with
+//! [`check_crust`](crate::check::check_crust); it never returns a mesh that fails.
+
+use std::path::Path;
+
+use mesh_io::{OutputFormat, TriMesh, UnitCubeTransform};
+
+use crate::check::{check_crust, find_defects, CrustCheck};
+use crate::error::CrustError;
+use crate::resolve::{attempt, coincident_groups, resolve, split_loops, Target};
+
+/// How a format stores coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// float32 (GLB, glTF).
+    F32,
+    /// float64, lossless (OBJ and PLY as `mesh_io` writes them).
+    F64,
+}
+
+impl Precision {
+    /// The precision `format` stores positions in.
+    pub fn of_format(format: OutputFormat) -> Precision {
+        if format.stores_f32() {
+            Precision::F32
+        } else {
+            Precision::F64
+        }
+    }
+
+    /// The precision of the format `path`'s extension names.
+    ///
+    /// # Errors
+    /// An unknown extension ([`OutputFormat::from_path`]).
+    pub fn of_path(path: &Path) -> Result<Precision, mesh_io::MeshError> {
+        OutputFormat::from_path(path).map(Precision::of_format)
+    }
+
+    /// `x` rounded as the writer stores it (round to nearest even; overflow to ±∞).
+    pub fn round(self, x: f64) -> f64 {
+        match self {
+            Precision::F32 => x as f32 as f64,
+            Precision::F64 => x,
+        }
+    }
+
+    fn target(self) -> Target {
+        match self {
+            Precision::F32 => Target { round: |x| x as f32 as f64, epsilon: f32::EPSILON as f64, distinct_positions: true },
+            Precision::F64 => Target { round: |x| x, epsilon: f64::EPSILON, distinct_positions: true },
+        }
+    }
+}
+
+/// The map from the crust's frame (the unit cube) to the output's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameMap {
+    /// Write the crust as it is.
+    Identity,
+    /// [`UnitCubeTransform::from_unit`], as the main job maps its outputs.
+    UnitCube(UnitCubeTransform),
+    /// A row-major affine 4×4 matrix on homogeneous column vectors, as a sites file stores
+    /// it ([`crate::SitesFile::to_mesh_frame`] evaluates it the same way).
+    Matrix([[f64; 4]; 4]),
+}
+
+impl From<UnitCubeTransform> for FrameMap {
+    fn from(t: UnitCubeTransform) -> Self {
+        FrameMap::UnitCube(t)
+    }
+}
+
+impl From<&UnitCubeTransform> for FrameMap {
+    fn from(t: &UnitCubeTransform) -> Self {
+        FrameMap::UnitCube(*t)
+    }
+}
+
+impl From<[[f64; 4]; 4]> for FrameMap {
+    fn from(m: [[f64; 4]; 4]) -> Self {
+        FrameMap::Matrix(m)
+    }
+}
+
+impl FrameMap {
+    /// Map one point (f64, before the output's rounding).
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        match self {
+            FrameMap::Identity => p,
+            FrameMap::UnitCube(t) => t.from_unit(p),
+            FrameMap::Matrix(m) => [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3]),
+        }
+    }
+
+    /// Whether the map mirrors (triangles are then reversed to stay counter-clockwise
+    /// seen from outside).
+    pub fn mirrors(&self) -> bool {
+        match self {
+            FrameMap::Identity => false,
+            FrameMap::UnitCube(t) => t.scale < 0.0,
+            FrameMap::Matrix(m) => linear_determinant(m) < 0.0,
+        }
+    }
+
+    fn check(&self) -> Result<(), CrustError> {
+        let bad = match self {
+            FrameMap::Identity => false,
+            FrameMap::UnitCube(t) => !(t.scale.is_finite() && t.scale != 0.0 && t.center.iter().all(|c| c.is_finite())),
+            FrameMap::Matrix(m) => {
+                !(m.iter().flatten().all(|x| x.is_finite())
+                    && m[3] == [0.0, 0.0, 0.0, 1.0]
+                    && linear_determinant(m).is_normal())
+            }
+        };
+        if bad {
+            return Err(CrustError::Unwritable(format!(
+                "the map to the output frame ({self:?}) is not a finite invertible affine map"
+            )));
+        }
+        Ok(())
+    }
+}
+
+fn linear_determinant(m: &[[f64; 4]; 4]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+/// A crust ready to write.
+#[derive(Clone, Debug)]
+pub struct Finalized {
+    /// The mesh to write: every position is exactly representable in the output's
+    /// precision (the writer stores it unchanged), distinct vertices have distinct
+    /// positions (a reader's welding changes nothing), and it passes
+    /// [`check_crust`](crate::check::check_crust).
+    pub mesh: TriMesh,
+    /// The exact check of `mesh`.
+    pub check: CrustCheck,
+    /// Vertices merged into a neighbour because rounding collapsed or crossed what they
+    /// bound (0 when rounding broke nothing).
+    pub num_merged_vertices: usize,
+    /// The largest edge length merged (output units; 0 when none or only coincident
+    /// vertices were merged).
+    pub merge_distance: f64,
+    /// Vertices moved apart, by a few units in the last place into their own solid,
+    /// because they shared a position with another vertex (split vertices, or vertices
+    /// that rounding made coincident and that could not be merged).
+    pub num_separated_vertices: usize,
+}
+
+/// The crust exactly as a file in `precision` will hold it, checked.
+///
+/// - `mesh`: a crust in the unit cube (for example [`crate::Crust::mesh`]), f64;
+/// - `map`: to the output's frame ([`FrameMap`]; a [`UnitCubeTransform`], a 4×4 matrix,
+///   or the identity); triangles are reversed when it mirrors;
+/// - `precision`: of the format ([`Precision::of_path`], [`Precision::of_format`]).
+///
+/// Positions are mapped in f64 and rounded to `precision` as the writer rounds them.
+/// Vertices that land on the same position are merged (a reader welds them anyway), and
+/// the mesh is rebuilt from the merged polygons; where that is not a valid crust, the
+/// vertices around the faulty triangles joined by short edges are merged as well (the
+/// repair of [`Crust::extract`](crate::Crust::extract), in units of the output's
+/// precision), and copies of one position that must stay apart (split vertices) are
+/// moved apart by a few units in the last place into their own solid. The result is
+/// checked exactly; when rounding broke nothing it is the mapped mesh itself.
+///
+/// # Errors
+/// [`CrustError::Unwritable`] when `map` is not a finite invertible affine map, when a
+/// coordinate is not finite in `precision` or beyond the ±1e30 that readers accept (such
+/// as a scale of 1e300 with f32), or when rounding breaks the crust beyond repair (too
+/// coarse a precision for the mesh's detail; write OBJ or PLY instead). Never a mesh that
+/// fails the check.
+pub fn finalize(mesh: &TriMesh, map: impl Into<FrameMap>, precision: Precision) -> Result<Finalized, CrustError> {
+    let map = map.into();
+    map.check()?;
+    let mut positions = Vec::with_capacity(mesh.positions.len());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let q = map.apply(*p).map(|x| {
+            let r = precision.round(x);
+            if r == 0.0 {
+                0.0 // readers weld −0.0 with 0.0
+            } else {
+                r
+            }
+        });
+        if let Some(k) = (0..3).find(|&k| !(q[k].abs() <= mesh_io::limits::MAX_ABS_COORDINATE)) {
+            let what = if q[k].is_finite() { "beyond the ±1e30 that readers accept" } else { "not a finite number" };
+            return Err(CrustError::Unwritable(format!(
+                "vertex {i} at {p:?} maps to {} = {:e} in the output frame ({precision:?}), {what}; \
+                 the transform's scale or offset is out of range",
+                ["x", "y", "z"][k],
+                q[k]
+            )));
+        }
+        positions.push(q);
+    }
+    let flip = map.mirrors();
+    let triangles: Vec<[u32; 3]> =
+        mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect();
+    let out = TriMesh { positions, triangles };
+    if out.triangles.is_empty() {
+        let check = check_crust(&TriMesh::default()).map_err(CrustError::Internal)?;
+        return Ok(Finalized {
+            mesh: TriMesh::default(),
+            check,
+            num_merged_vertices: 0,
+            merge_distance: 0.0,
+            num_separated_vertices: 0,
+        });
+    }
+    // Rounding broke nothing: the mapped mesh itself.
+    if coincident_groups(&out).is_empty() {
+        if let Ok(check) = find_defects(&out, true) {
+            return Ok(Finalized { mesh: out, check, num_merged_vertices: 0, merge_distance: 0.0, num_separated_vertices: 0 });
+        }
+    }
+    // Weld as a reader will, rebuild, and repair what remains.
+    let mut first_at: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
+    let weld: Vec<u32> =
+        (0..out.positions.len() as u32).map(|v| *first_at.entry(out.positions[v as usize].map(f64::to_bits)).or_insert(v)).collect();
+    let num_welded = weld.iter().enumerate().filter(|&(v, &w)| w as usize != v).count();
+    let triangles: Vec<Vec<u32>> = out.triangles.iter().map(|t| t.to_vec()).collect();
+    let polygons = split_loops(&triangles, &weld);
+    let target = precision.target();
+    let unwritable = |e: CrustError| {
+        CrustError::Unwritable(format!(
+            "rounding the crust to {precision:?} in the output frame breaks it beyond repair ({e}); \
+             write a lossless format (.obj or .ply) instead"
+        ))
+    };
+    match attempt(&polygons, &out.positions, &target) {
+        Ok((built, check, num_separated)) => Ok(Finalized {
+            mesh: compact(built.mesh),
+            check,
+            num_merged_vertices: num_welded,
+            merge_distance: 0.0,
+            num_separated_vertices: num_separated,
+        }),
+        Err(first) => {
+            let o = resolve(&polygons, &out.positions, &target, first).map_err(unwritable)?;
+            Ok(Finalized {
+                mesh: compact(o.built.mesh),
+                check: o.check,
+                num_merged_vertices: num_welded + o.num_merged,
+                merge_distance: o.merge_distance,
+                num_separated_vertices: o.num_separated,
+            })
+        }
+    }
+}
+
+/// Drop vertices no triangle uses (the builder makes none; kept for safety), keeping order.
+fn compact(mesh: TriMesh) -> TriMesh {
+    let mut used = vec![false; mesh.positions.len()];
+    for t in &mesh.triangles {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    if used.iter().all(|&u| u) {
+        return mesh;
+    }
+    let mut id = vec![u32::MAX; mesh.positions.len()];
+    let mut positions = Vec::new();
+    for (v, p) in mesh.positions.iter().enumerate() {
+        if used[v] {
+            id[v] = positions.len() as u32;
+            positions.push(*p);
+        }
+    }
+    TriMesh { positions, triangles: mesh.triangles.iter().map(|t| t.map(|v| id[v as usize])).collect() }
+}

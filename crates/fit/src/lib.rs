@@ -1,0 +1,35 @@
+//! The main job of voronoi-fit as a library call: [`fit`] takes a triangle mesh and a
+//! [`FitConfig`] and returns the trained sites, the checked crust in the input's frame and
+//! a serialisable [`FitReport`]. The CLI (`voronoi-fit MESH`), the sphere study, batch
+//! runs and the Python package all call it.
+//!
+//! Stages (each timed in the report): drop unreferenced vertices and normalise into the
+//! unit cube ([`data`]); build the occupancy oracle; sample and label the training pool by
+//! the workspace's one inside rule ([`occupancy::Config::is_inside_winding`]); train the
+//! sites with the soft-Voronoi ([`soft_voronoi::Trainer`]), checkpointing as asked; extract
+//! and check the crust with its retry policy ([`crust_of`]) and map it back; measure the
+//! misclassification on fresh samples and the `eval` metrics against the input.
+//!
+//! # Example
+//! ```no_run
+//! let mesh = mesh_io::read_mesh(std::path::Path::new("bunny.obj"))?;
+//! let config = fit::FitConfig::new("bunny.obj", 8192);
+//! let out = fit::fit(&mesh, &config, &mut fit::NoProgress)?;
+//! println!("{} crust triangles", out.crust.triangles.len());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub mod config;
+pub mod crust_step;
+pub mod data;
+pub mod error;
+pub mod progress;
+pub mod report;
+mod run;
+
+pub use config::{Checkpointing, EvalSampling, FitConfig, Sampling, DEFAULT_SITES, MARGIN};
+pub use crust_step::{crust_of, CheckedCrust};
+pub use error::FitError;
+pub use progress::{NoProgress, Progress, Stage};
+pub use report::FitReport;
+pub use run::{fit, FitOutput};

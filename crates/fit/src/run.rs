@@ -1,0 +1,252 @@
+//! The driver: [`fit`], one stage after another.
+
+use std::time::Instant;
+
+use crust::SitesFile;
+use mesh_io::{TopologyReport, TriMesh, UnitCubeTransform};
+use occupancy::sample::SurfaceSampler;
+use occupancy::MeshOracle;
+use soft_voronoi::{checkpoint, classify, MeshSolid, TrainState, Trainer, TrainingData};
+
+use crate::config::FitConfig;
+use crate::crust_step::{crust_of, CheckedCrust};
+use crate::data::{compact, labelled_samples};
+use crate::error::FitError;
+use crate::progress::{Progress, Stage};
+use crate::report::*;
+
+/// What a fit produces.
+pub struct FitOutput {
+    /// The trained sites (trainable then boundary; unit-cube coordinates, moved by the
+    /// crust's jitter if it retried), their labels and the map back to the input's frame.
+    pub sites: SitesFile,
+    /// The checked crust in the input's frame (counter-clockwise seen from outside).
+    pub crust: TriMesh,
+    /// The training state at the end (sites, optimiser, losses).
+    pub state: TrainState,
+    /// The report.
+    pub report: FitReport,
+}
+
+/// The mesh in the unit cube and what is built on it.
+struct Prepared {
+    mesh: TriMesh,
+    transform: UnitCubeTransform,
+    unit: TriMesh,
+    topology: TopologyReport,
+}
+
+fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
+    let name = &config.sampling.mesh;
+    let mesh = compact(input);
+    if mesh.triangles.is_empty() {
+        return Err(FitError::Input(format!("{name}: the mesh has no triangles; nothing to fit")));
+    }
+    let transform = UnitCubeTransform::of_mesh(&mesh, config.sampling.margin).ok_or_else(|| {
+        FitError::Input(format!("{name}: the mesh has no extent (all vertices coincide) or non-finite coordinates"))
+    })?;
+    let unit = transform.mesh_to_unit(&mesh);
+    let topology = TopologyReport::of(&mesh);
+    Ok(Prepared { mesh, transform, unit, topology })
+}
+
+/// Stage timer.
+struct Lap {
+    t: Instant,
+}
+
+impl Lap {
+    fn next(&mut self) -> f64 {
+        let s = self.t.elapsed().as_secs_f64();
+        self.t = Instant::now();
+        s
+    }
+}
+
+/// Fits `config.train.num_sites` labelled sites to `input` and returns them with their
+/// checked crust and the report. Reproducible from the seed, bit for bit on any thread
+/// count; with `config.checkpointing` the optimiser's state is saved as it goes, and
+/// `config.resume` continues a saved run exactly.
+///
+/// - `input`: #V×3 f64 positions and #F×3 u32 triangles in any frame and unit; unreferenced
+///   vertices are ignored.
+///
+/// # Errors
+/// [`FitError::Input`] for unusable meshes (no triangles, no extent, no area, nothing
+/// inside) and settings; [`FitError::Interrupted`] when `progress` asked to stop (after the
+/// checkpoint is written); [`FitError::Failure`] otherwise.
+pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
+    let t_all = Instant::now();
+    config.validate()?;
+    let name = &config.sampling.mesh;
+    let mut lap = Lap { t: Instant::now() };
+    let mut timings = Timings::default();
+
+    progress.stage(Stage::Load);
+    let p = prepare(input, config)?;
+    timings.load = lap.next();
+    progress.stage(Stage::Oracle);
+    let oracle = MeshOracle::from_mesh(&p.unit, &occupancy::Config::default())
+        .map_err(|e| FitError::Input(format!("{name}: {e}")))?;
+    let sampler = SurfaceSampler::from_mesh(&p.unit)
+        .map_err(|e| FitError::Input(format!("{name}: {e} (the mesh has no area to sample)")))?;
+    let solid = MeshSolid { oracle: &oracle };
+    timings.oracle = lap.next();
+
+    progress.stage(Stage::Sample);
+    let diagonal = p.unit.diagonal();
+    let s = &config.sampling;
+    let train_sigmas: Vec<f64> = s.sigmas.iter().map(|x| x * diagonal).collect();
+    let (data, _) = labelled_samples(&sampler, &solid, s.samples, &train_sigmas, s.seed)?;
+    if !data.occupancy.iter().any(|&o| o) {
+        return Err(FitError::Input(format!(
+            "{name}: no training sample is inside the mesh (|winding number| < 0.5 everywhere): it encloses no \
+             volume. Close the surface (fill its holes) and try again"
+        )));
+    }
+    timings.sample = lap.next();
+
+    progress.stage(Stage::Train);
+    let trainer = train(&data, &solid, config, progress)?;
+    timings.train = lap.next();
+
+    progress.stage(Stage::Crust);
+    let (mut sites, labels, num_projected) = trainer.final_sites();
+    let checked = crust_of(&mut sites, &labels, s.seed)?;
+    let crust_mesh = checked.in_frame(&p.transform);
+    timings.crust = lap.next();
+
+    progress.stage(Stage::Evaluate);
+    let quality = misclassification(&sampler, &solid, &sites, &labels, config, diagonal)?;
+    timings.evaluate = lap.next();
+
+    progress.stage(Stage::Metrics);
+    let metrics = if config.skip_metrics {
+        MetricsReport::Skipped { skipped: "not asked for".into() }
+    } else {
+        // The crust was checked above, so its validity is not recomputed.
+        let opts = metrics::EvalOptions { skip_validity: true, ..Default::default() };
+        match metrics::evaluate(&p.mesh, &crust_mesh, &opts) {
+            Ok(m) => MetricsReport::Done(Box::new(m)),
+            Err(e) => MetricsReport::Failed { error: e.to_string() },
+        }
+    };
+    timings.metrics = lap.next();
+
+    let state = trainer.state().clone();
+    let report = FitReport {
+        format_version: 1,
+        input: InputReport {
+            path: name.clone(),
+            num_vertices: input.positions.len(),
+            num_triangles: input.triangles.len(),
+            is_closed: p.topology.is_closed,
+            is_manifold: p.topology.is_manifold,
+            signed_volume: p.topology.signed_volume,
+        },
+        settings: SettingsReport {
+            train: state.config.clone(),
+            preset: config.preset.clone(),
+            samples: s.samples,
+            near_surface_sigmas_of_diagonal: s.sigmas.clone(),
+            near_surface_sigmas: train_sigmas,
+            margin: s.margin,
+            eval_samples: config.eval.samples.max(2),
+            resumed_from: config.resume.as_ref().map(|r| r.1.clone()),
+            threads: rayon::current_num_threads(),
+        },
+        transform: TransformReport { center: p.transform.center, scale: p.transform.scale },
+        timings_seconds: timings,
+        losses: LossesReport::of(&state),
+        quality,
+        metrics,
+        crust: crust_report(&checked, &crust_mesh, num_projected),
+        outputs: OutputsReport::default(),
+        total_seconds: t_all.elapsed().as_secs_f64(),
+    };
+    let sites = SitesFile { sites, inside: labels, transform: p.transform.from_unit_matrix() };
+    Ok(FitOutput { sites, crust: crust_mesh, state, report })
+}
+
+/// Trains to the end, checkpointing as configured; stops with a checkpoint when
+/// `progress` asks.
+fn train<'a>(
+    data: &'a TrainingData,
+    solid: &'a MeshSolid,
+    config: &FitConfig,
+    progress: &mut dyn Progress,
+) -> Result<Trainer<'a>, FitError> {
+    let input = |e: soft_voronoi::TrainError| FitError::Input(e.to_string());
+    let mut trainer = match &config.resume {
+        Some((state, path)) => Trainer::resume(state.clone(), data, solid, path).map_err(input)?,
+        None => Trainer::new(config.train.clone(), data, solid).map_err(input)?,
+    };
+    let context = serde_json::to_string(&config.sampling).map_err(|e| FitError::Failure(e.to_string()))?;
+    let steps = trainer.config().steps;
+    progress.train_start(trainer.state().step, steps);
+    while !trainer.is_done() {
+        let s = trainer.step().map_err(|e| FitError::Failure(e.to_string()))?;
+        progress.train_step(&s);
+        let stop = progress.should_stop();
+        if let Some(c) = &config.checkpointing {
+            let due = c.every > 0 && (s.step + 1) % c.every == 0;
+            if (due || stop) && !trainer.is_done() {
+                checkpoint::write(&c.path, trainer.state(), &context).map_err(|e| FitError::Failure(e.to_string()))?;
+            }
+            if stop && !trainer.is_done() {
+                progress.train_end();
+                return Err(FitError::Interrupted { step: s.step + 1, steps, checkpoint: c.path.clone() });
+            }
+        } else if stop && !trainer.is_done() {
+            progress.train_end();
+            return Err(FitError::Failure(format!("stopped at step {} of {steps} without a checkpoint", s.step + 1)));
+        }
+    }
+    progress.train_end();
+    Ok(trainer)
+}
+
+/// Misclassification of the hard Voronoi occupancy on a fresh pool (another seed stream
+/// than training: seed XOR [`vf_common::rng::seed_tweak::EVALUATION`]).
+fn misclassification(
+    sampler: &SurfaceSampler,
+    solid: &MeshSolid,
+    sites: &[[f64; 3]],
+    labels: &[bool],
+    config: &FitConfig,
+    diagonal: f64,
+) -> Result<QualityReport, FitError> {
+    let eval_seed = config.sampling.seed ^ vf_common::rng::seed_tweak::EVALUATION;
+    let eval_sigmas: Vec<f64> = config.eval.sigmas.iter().map(|x| x * diagonal).collect();
+    let (eval, num_uniform) = labelled_samples(sampler, solid, config.eval.samples.max(2), &eval_sigmas, eval_seed)?;
+    let predicted = classify(sites, labels, &eval.points);
+    let wrong = |r: std::ops::Range<usize>| r.filter(|&i| predicted[i] != eval.occupancy[i]).count();
+    let n = eval.points.len();
+    let (wrong_u, wrong_n) = (wrong(0..num_uniform), wrong(num_uniform..n));
+    Ok(QualityReport {
+        misclassification: (wrong_u + wrong_n) as f64 / n as f64,
+        misclassification_uniform: wrong_u as f64 / num_uniform.max(1) as f64,
+        misclassification_near_surface: wrong_n as f64 / (n - num_uniform).max(1) as f64,
+        eval_seed,
+        eval_near_surface_sigmas_of_diagonal: config.eval.sigmas.clone(),
+        eval_near_surface_sigmas: eval_sigmas,
+    })
+}
+
+fn crust_report(checked: &CheckedCrust, mesh: &TriMesh, num_projected: usize) -> CrustReport {
+    let r = &checked.check.report;
+    CrustReport {
+        num_sites: checked.crust.stats.num_sites,
+        num_inside: checked.crust.stats.num_inside,
+        num_sites_projected_into_cube: num_projected,
+        jitter_retries: checked.retries,
+        num_vertices: mesh.positions.len(),
+        num_triangles: mesh.triangles.len(),
+        num_components: r.num_components,
+        genus: r.genus,
+        is_closed: r.is_closed,
+        is_manifold: r.is_manifold,
+        self_intersections: 0,
+        volume: TopologyReport::of(mesh).signed_volume,
+    }
+}
