@@ -197,6 +197,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let out = outputs(&args)?;
     let config = config_from_args(&args, &out)?;
     let input = read_input(&args)?;
+    if OutputFormat::from_path(&out.mesh)?.stores_f32() {
+        // The crust is written in the input's frame; refuse now if float32 cannot resolve it.
+        mesh_io::check_f32_resolution(&input, &args.mesh)?;
+    }
     let bar = if args.quiet || args.json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(0) };
     bar.set_style(
         indicatif::ProgressStyle::with_template("train {bar:30} {pos}/{len} steps, loss {msg}, {elapsed} (ETA {eta})")

@@ -145,3 +145,15 @@ fn weld_tolerance_out_of_range_is_a_usage_error() {
         assert!(stderr(&o).contains("--weld-tolerance"), "{}", stderr(&o));
     }
 }
+
+/// The main job refuses the 1e300 mesh before any work (it used to fit it and write a GLB
+/// of infinite vertices), and writes nothing.
+#[test]
+fn the_main_job_refuses_coordinates_beyond_1e30() {
+    let d = tempfile::tempdir().unwrap();
+    let input = write(d.path(), "big.obj", "v 1e300 0 0\nv 0 1e300 0\nv 0 0 1e300\nf 1 2 3\n");
+    let out_dir = tempfile::tempdir().unwrap();
+    let o = bin().arg(&input).arg("-o").arg(out_dir.path().join("big.glb")).arg("--quiet").output().unwrap();
+    assert_refused(&o, &input, "1.000e300");
+    assert_eq!(std::fs::read_dir(out_dir.path()).unwrap().count(), 0, "no output, no temporary file");
+}

@@ -5,7 +5,8 @@
 
 /// Cube corners: bit 0 → +axis 0, bit 1 → +axis 1, bit 2 → +axis 2. Faces as corner
 /// cycles counter-clockwise seen from outside the cube.
-pub(super) const FACES: [[usize; 4]; 6] = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
+pub(super) const FACES: [[usize; 4]; 6] =
+    [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
 
 /// Local edge index of the cube edge between corners `a` and `b` (adjacent): the axis
 /// (bit that differs) times 4 plus the other two bits of the lower corner.

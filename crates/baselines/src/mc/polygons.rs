@@ -5,7 +5,12 @@
 /// A tube joining two polygons whose oriented edges it keeps as its boundary: a ring of
 /// new vertices halfway between `c1` and the cell's middle (so that no tube edge lies in a
 /// cell face), a strip from `c1` to the ring, a strip from the ring to `c2`.
-pub(super) fn tube_triangles(c1: &[(u32, u8)], c2: &[(u32, u8)], out: &mut Vec<[u32; 3]>, positions: &mut Vec<[f64; 3]>) {
+pub(super) fn tube_triangles(
+    c1: &[(u32, u8)],
+    c2: &[(u32, u8)],
+    out: &mut Vec<[u32; 3]>,
+    positions: &mut Vec<[f64; 3]>,
+) {
     let centroid = |c: &[(u32, u8)], positions: &Vec<[f64; 3]>| {
         let mut m = [0.0; 3];
         for &(v, _) in c {
