@@ -5,7 +5,7 @@
 //! SVG's proportional text too.
 
 use crate::ticks::{axis_ticks, log_ticks_exp, Label};
-use crate::{series_color, series_marker, Chart, Marker, Rgb};
+use crate::{series_color, series_marker, Chart, Marker, Rgb, Series};
 
 /// Character cell (width, height) of each text role, in pixels.
 pub(crate) const TITLE_FONT: (f64, f64) = (10.0, 20.0);
@@ -198,21 +198,7 @@ pub(crate) fn tick_label_width(label: &Label) -> f64 {
 
 impl Layout {
     pub(crate) fn new(chart: &Chart, w: f64, h: f64) -> Layout {
-        // Showable values, for the ranges.
-        let mut xs = Vec::new();
-        let mut ys = Vec::new();
-        for s in &chart.series {
-            for (j, &(x, y)) in s.points.iter().enumerate() {
-                if !(showable(x, chart.log_x) && showable(y, chart.log_y)) {
-                    continue;
-                }
-                xs.push(x);
-                ys.push(y);
-                if let Some(&(lo, hi)) = s.band.as_ref().and_then(|b| b.get(j)) {
-                    ys.extend([lo, hi].into_iter().filter(|&v| showable(v, chart.log_y)));
-                }
-            }
-        }
+        let (xs, ys) = showable_values(chart);
         let empty = xs.is_empty();
         let mut x = Axis::new(&xs, chart.log_x);
         let mut y = Axis::new(&ys, chart.log_y);
@@ -220,13 +206,7 @@ impl Layout {
         let title = one_line(&chart.title);
         let x_label = one_line(&chart.x_label);
         let y_label = one_line(&chart.y_label);
-
-        // Legend width from the (possibly shortened) names.
-        let max_chars = (((0.3 * w - 70.0) / LEGEND_FONT.0).floor() as usize).max(6);
-        let names: Vec<String> = chart.series.iter().map(|s| truncate(&one_line(&s.name), max_chars)).collect();
-        let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
-        let legend_w =
-            if names.is_empty() { 0.0 } else { 12.0 + LEGEND_SAMPLE + 10.0 + LEGEND_FONT.0 * longest as f64 + 12.0 };
+        let (names, legend_w) = legend_names(chart, w);
 
         let y_tick_w = y.major.iter().map(|(_, l)| tick_label_width(l)).fold(0.0, f64::max);
         let x0 = PAD + if y_label.is_empty() { 0.0 } else { LABEL_FONT.1 + 12.0 } + y_tick_w + TICK_LEN + 6.0;
@@ -239,71 +219,8 @@ impl Layout {
         let x_tick_y = plot.y1 + TICK_LEN + 4.0 + EXP_RAISE + TICK_FONT.1 / 2.0;
         let y_tick_x = plot.x0 - TICK_LEN - 6.0;
 
-        let mut series = Vec::new();
-        for (i, s) in chart.series.iter().enumerate() {
-            let mut runs = Vec::new();
-            let mut run = Vec::new();
-            let mut bars = Vec::new();
-            for (j, &(px, py)) in s.points.iter().enumerate() {
-                if !(showable(px, chart.log_x) && showable(py, chart.log_y)) {
-                    if !run.is_empty() {
-                        runs.push(std::mem::take(&mut run));
-                    }
-                    continue;
-                }
-                let (cx, cy) = (x.px(px), y.px(py));
-                run.push((cx, cy));
-                if let Some(&(lo, hi)) = s.band.as_ref().and_then(|b| b.get(j)) {
-                    if lo.is_nan() || hi.is_nan() {
-                        continue;
-                    }
-                    // An end that cannot be shown runs to the plot edge on its side, uncapped.
-                    let end = |v: f64| {
-                        let p = if showable(v, chart.log_y) {
-                            y.px(v)
-                        } else if v > 0.0 {
-                            f64::NEG_INFINITY
-                        } else {
-                            f64::INFINITY
-                        };
-                        (p.clamp(plot.y0, plot.y1), (plot.y0..=plot.y1).contains(&p))
-                    };
-                    let (a, b) = (end(lo), end(hi));
-                    let (top, bottom) = if a.0 <= b.0 { (a, b) } else { (b, a) };
-                    bars.push(ErrorBar { x: cx, top: top.0, bottom: bottom.0, cap_top: top.1, cap_bottom: bottom.1 });
-                }
-            }
-            if !run.is_empty() {
-                runs.push(run);
-            }
-            series.push(SeriesGeom { color: series_color(i), marker: series_marker(i), runs, bars });
-        }
-
-        let legend = (!names.is_empty()).then(|| {
-            let lx0 = plot.x1 + PAD;
-            let rows: Vec<LegendRow> = names
-                .into_iter()
-                .enumerate()
-                .map(|(i, name)| LegendRow {
-                    name,
-                    color: series_color(i),
-                    marker: series_marker(i),
-                    y: plot.y0 + 6.0 + LEGEND_ROW * (i as f64 + 0.5),
-                })
-                .collect();
-            Legend {
-                rect: Rect {
-                    x0: lx0,
-                    y0: plot.y0,
-                    x1: lx0 + legend_w,
-                    y1: plot.y0 + 12.0 + LEGEND_ROW * rows.len() as f64,
-                },
-                sample_x0: lx0 + 12.0,
-                sample_x1: lx0 + 12.0 + LEGEND_SAMPLE,
-                text_x: lx0 + 12.0 + LEGEND_SAMPLE + 10.0,
-                rows,
-            }
-        });
+        let series = chart.series.iter().enumerate().map(|(i, s)| series_geom(chart, i, s, &x, &y, plot)).collect();
+        let legend = legend(names, legend_w, plot);
 
         let text = |t: String, x: f64, y: f64| (!t.is_empty()).then_some(TextItem { text: t, x, y });
         Layout {
@@ -326,6 +243,112 @@ impl Layout {
             legend,
         }
     }
+}
+
+/// The showable x and y values of every point (with the showable ends of its error bar),
+/// for the axis ranges.
+fn showable_values(chart: &Chart) -> (Vec<f64>, Vec<f64>) {
+    let mut xs = Vec::new();
+    let mut ys = Vec::new();
+    for s in &chart.series {
+        for (j, &(x, y)) in s.points.iter().enumerate() {
+            if !(showable(x, chart.log_x) && showable(y, chart.log_y)) {
+                continue;
+            }
+            xs.push(x);
+            ys.push(y);
+            if let Some(&(lo, hi)) = s.band.as_ref().and_then(|b| b.get(j)) {
+                ys.extend([lo, hi].into_iter().filter(|&v| showable(v, chart.log_y)));
+            }
+        }
+    }
+    (xs, ys)
+}
+
+/// The legend's (possibly shortened) names and its width in pixels (0 without series).
+fn legend_names(chart: &Chart, w: f64) -> (Vec<String>, f64) {
+    let max_chars = (((0.3 * w - 70.0) / LEGEND_FONT.0).floor() as usize).max(6);
+    let names: Vec<String> = chart.series.iter().map(|s| truncate(&one_line(&s.name), max_chars)).collect();
+    let longest = names.iter().map(|n| n.chars().count()).max().unwrap_or(0);
+    let legend_w =
+        if names.is_empty() { 0.0 } else { 12.0 + LEGEND_SAMPLE + 10.0 + LEGEND_FONT.0 * longest as f64 + 12.0 };
+    (names, legend_w)
+}
+
+/// Series `i` in pixels: runs of showable points and error bars.
+fn series_geom(chart: &Chart, i: usize, s: &Series, x: &Axis, y: &Axis, plot: Rect) -> SeriesGeom {
+    let mut runs = Vec::new();
+    let mut run = Vec::new();
+    let mut bars = Vec::new();
+    for (j, &(px, py)) in s.points.iter().enumerate() {
+        if !(showable(px, chart.log_x) && showable(py, chart.log_y)) {
+            if !run.is_empty() {
+                runs.push(std::mem::take(&mut run));
+            }
+            continue;
+        }
+        let (cx, cy) = (x.px(px), y.px(py));
+        run.push((cx, cy));
+        if let Some(&(lo, hi)) = s.band.as_ref().and_then(|b| b.get(j)) {
+            if let Some(bar) = error_bar(cx, lo, hi, y, chart.log_y, plot) {
+                bars.push(bar);
+            }
+        }
+    }
+    if !run.is_empty() {
+        runs.push(run);
+    }
+    SeriesGeom { color: series_color(i), marker: series_marker(i), runs, bars }
+}
+
+/// The error bar from `lo` to `hi` at pixel column `cx`; `None` if an end is NaN. An end
+/// that cannot be shown runs to the plot edge on its side, uncapped.
+fn error_bar(cx: f64, lo: f64, hi: f64, y: &Axis, log_y: bool, plot: Rect) -> Option<ErrorBar> {
+    if lo.is_nan() || hi.is_nan() {
+        return None;
+    }
+    let end = |v: f64| {
+        let p = if showable(v, log_y) {
+            y.px(v)
+        } else if v > 0.0 {
+            f64::NEG_INFINITY
+        } else {
+            f64::INFINITY
+        };
+        (p.clamp(plot.y0, plot.y1), (plot.y0..=plot.y1).contains(&p))
+    };
+    let (a, b) = (end(lo), end(hi));
+    let (top, bottom) = if a.0 <= b.0 { (a, b) } else { (b, a) };
+    Some(ErrorBar { x: cx, top: top.0, bottom: bottom.0, cap_top: top.1, cap_bottom: bottom.1 })
+}
+
+/// The legend right of the plot, one row per name (`None` without series).
+fn legend(names: Vec<String>, legend_w: f64, plot: Rect) -> Option<Legend> {
+    (!names.is_empty()).then(|| {
+        let lx0 = plot.x1 + PAD;
+        let rows: Vec<LegendRow> = names
+            .into_iter()
+            .enumerate()
+            .map(|(i, name)| LegendRow {
+                name,
+                color: series_color(i),
+                marker: series_marker(i),
+                y: plot.y0 + 6.0 + LEGEND_ROW * (i as f64 + 0.5),
+            })
+            .collect();
+        Legend {
+            rect: Rect {
+                x0: lx0,
+                y0: plot.y0,
+                x1: lx0 + legend_w,
+                y1: plot.y0 + 12.0 + LEGEND_ROW * rows.len() as f64,
+            },
+            sample_x0: lx0 + 12.0,
+            sample_x1: lx0 + 12.0 + LEGEND_SAMPLE,
+            text_x: lx0 + 12.0 + LEGEND_SAMPLE + 10.0,
+            rows,
+        }
+    })
 }
 
 /// A marker's outline, centred on a point.

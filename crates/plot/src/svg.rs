@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use crate::layout::{marker_shape, Layout, MarkerShape, EXP_RAISE};
+use crate::layout::{marker_shape, Layout, Legend, MarkerShape, EXP_RAISE};
 use crate::ticks::Label;
 use crate::Rgb;
 
@@ -106,6 +106,22 @@ fn marker(out: &mut String, m: crate::Marker, cx: f64, cy: f64, color: Rgb) {
 
 pub(crate) fn render(l: &Layout) -> String {
     let mut o = String::new();
+    header(&mut o, l);
+    grid(&mut o, l);
+    ticks_and_frame(&mut o, l);
+    tick_labels(&mut o, l);
+    series(&mut o, l);
+    labels(&mut o, l);
+    if let Some(g) = &l.legend {
+        legend(&mut o, g);
+    }
+    o.push_str("</svg>\n");
+    o
+}
+
+/// XML declaration, the `<svg>` element, the title, the white background and the plot
+/// area's clip path.
+fn header(o: &mut String, l: &Layout) {
     let p = l.plot;
     let _ = writeln!(o, r#"<?xml version="1.0" encoding="UTF-8"?>"#);
     let _ = writeln!(
@@ -126,8 +142,12 @@ pub(crate) fn render(l: &Layout) -> String {
         n(p.x1 - p.x0),
         n(p.y1 - p.y0)
     );
+}
 
-    // Grid: minor first, then major.
+/// Grid lines, minor first, then major; opens the crisp-edged group that
+/// [`ticks_and_frame`] closes.
+fn grid(o: &mut String, l: &Layout) {
+    let p = l.plot;
     o.push_str(r#"<g shape-rendering="crispEdges" stroke-width="1">"#);
     o.push('\n');
     for &x in &l.x.minor {
@@ -166,7 +186,11 @@ pub(crate) fn render(l: &Layout) -> String {
             y = n(*y)
         );
     }
-    // Tick marks and the frame.
+}
+
+/// Tick marks and the frame; closes the group [`grid`] opened.
+fn ticks_and_frame(o: &mut String, l: &Layout) {
+    let p = l.plot;
     for (x, _) in &l.x.major {
         let _ = writeln!(
             o,
@@ -194,18 +218,22 @@ pub(crate) fn render(l: &Layout) -> String {
         n(p.y1 - p.y0)
     );
     o.push_str("</g>\n");
+}
 
-    // Tick labels.
+/// The tick labels of both axes.
+fn tick_labels(o: &mut String, l: &Layout) {
     o.push_str("<g fill=\"black\">\n");
     for (x, label) in &l.x.major {
-        tick_label(&mut o, label, *x, l.x_tick_y, "middle");
+        tick_label(o, label, *x, l.x_tick_y, "middle");
     }
     for (y, label) in &l.y.major {
-        tick_label(&mut o, label, l.y_tick_x, *y, "end");
+        tick_label(o, label, l.y_tick_x, *y, "end");
     }
     o.push_str("</g>\n");
+}
 
-    // Series, clipped to the plot area.
+/// Every series (error bars, lines, markers), clipped to the plot area.
+fn series(o: &mut String, l: &Layout) {
     o.push_str(r#"<g clip-path="url(#plot-area)" stroke-linejoin="round" stroke-linecap="round">"#);
     o.push('\n');
     for s in &l.series {
@@ -224,12 +252,15 @@ pub(crate) fn render(l: &Layout) -> String {
             let _ = writeln!(o, r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="2"/>"#, pts.join(" "));
         }
         for &(x, y) in s.runs.iter().flatten() {
-            marker(&mut o, s.marker, x, y, s.color);
+            marker(o, s.marker, x, y, s.color);
         }
     }
     o.push_str("</g>\n");
+}
 
-    // Labels.
+/// Title, axis labels (shrunk to fit) and the empty-plot message.
+fn labels(o: &mut String, l: &Layout) {
+    let p = l.plot;
     if let Some(t) = &l.title {
         let size = fit(&t.text, TITLE_SIZE, true, l.w - 32.0);
         let _ = writeln!(
@@ -273,37 +304,35 @@ pub(crate) fn render(l: &Layout) -> String {
             escape(&t.text)
         );
     }
+}
 
-    // Legend.
-    if let Some(g) = &l.legend {
-        let r = g.rect;
+/// The legend box: a line sample with the marker and the name per series.
+fn legend(o: &mut String, g: &Legend) {
+    let r = g.rect;
+    let _ = writeln!(
+        o,
+        r##"<rect x="{}" y="{}" width="{}" height="{}" fill="white" stroke="#999999" stroke-width="1"/>"##,
+        n(r.x0),
+        n(r.y0),
+        n(r.x1 - r.x0),
+        n(r.y1 - r.y0)
+    );
+    for row in &g.rows {
         let _ = writeln!(
             o,
-            r##"<rect x="{}" y="{}" width="{}" height="{}" fill="white" stroke="#999999" stroke-width="1"/>"##,
-            n(r.x0),
-            n(r.y0),
-            n(r.x1 - r.x0),
-            n(r.y1 - r.y0)
+            r#"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="{}" stroke-width="2"/>"#,
+            n(g.sample_x0),
+            n(g.sample_x1),
+            row.color.hex(),
+            y = n(row.y)
         );
-        for row in &g.rows {
-            let _ = writeln!(
-                o,
-                r#"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="{}" stroke-width="2"/>"#,
-                n(g.sample_x0),
-                n(g.sample_x1),
-                row.color.hex(),
-                y = n(row.y)
-            );
-            marker(&mut o, row.marker, (g.sample_x0 + g.sample_x1) / 2.0, row.y, row.color);
-            let _ = writeln!(
-                o,
-                r#"<text x="{}" y="{}" font-size="{LEGEND_SIZE}">{}</text>"#,
-                n(g.text_x),
-                n(baseline(row.y, LEGEND_SIZE)),
-                escape(&row.name)
-            );
-        }
+        marker(o, row.marker, (g.sample_x0 + g.sample_x1) / 2.0, row.y, row.color);
+        let _ = writeln!(
+            o,
+            r#"<text x="{}" y="{}" font-size="{LEGEND_SIZE}">{}</text>"#,
+            n(g.text_x),
+            n(baseline(row.y, LEGEND_SIZE)),
+            escape(&row.name)
+        );
     }
-    o.push_str("</svg>\n");
-    o
 }

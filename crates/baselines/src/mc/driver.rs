@@ -32,7 +32,7 @@ pub fn marching_cubes(grid: ArrayView3<f64>, opts: &McOptions) -> Result<TriMesh
     Ok(TriMesh { positions: mesher.positions, triangles: mesher.triangles })
 }
 
-/// The errors of [`marching_cubes`].
+/// The errors of [`marching_cubes()`].
 fn check_inputs(grid: &ArrayView3<f64>, opts: &McOptions) -> Result<()> {
     let (nx, ny, nz) = grid.dim();
     if nx < 2 || ny < 2 || nz < 2 {

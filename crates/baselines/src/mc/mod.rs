@@ -60,7 +60,7 @@
 //!
 //! # Layout
 //!
-//! `driver` runs the cells ([`marching_cubes`]); `cube` numbers the cube's corners, edges
+//! `driver` runs the cells ([`marching_cubes()`]); `cube` numbers the cube's corners, edges
 //! and faces; `ambiguity` holds the face rule and the exact interior test; `classic` the
 //! classic table's triangulation; `polygons` the fans and tubes.
 
