@@ -1,10 +1,15 @@
 //! `voronoi-fit crust SITES.npz -o CRUST.glb [--cells CELLS.glb] [--json]`: the watertight
 //! crust (and optionally the convex inside cells) of a sites file, in the mesh frame.
+//!
+//! The crust written is the one checked: [`crust::output::finalize`] maps it to the mesh
+//! frame, rounds it as the output format stores it (float32 for GLB / glTF, f64 for OBJ
+//! and PLY), repairs what rounding breaks or refuses, and checks it exactly.
 
 use std::path::PathBuf;
 
 use anyhow::anyhow;
-use crust::{check::check_crust, Crust, CrustConfig, CrustError, SitesFile};
+use crust::output::{finalize, Precision};
+use crust::{Crust, CrustConfig, CrustError, SitesFile};
 use mesh_io::{GltfLayout, SceneMesh, TriMesh};
 
 use crate::cli_error::CliError;
@@ -52,16 +57,17 @@ pub fn run(args: Args) -> Result<(), CliError> {
         check_output_ext(c, &["glb", "gltf"])?;
     }
     let file = SitesFile::read(&args.sites).map_err(|e| CliError::BadInput(e.into()))?;
-    let mut crust = Crust::extract(&file.sites, &file.inside, &CrustConfig::default()).map_err(|e| match e {
-        CrustError::Internal(_) => CliError::Failure(anyhow!("{}: {e}", args.sites.display())),
+    let classify = |e: CrustError| match e {
+        CrustError::Internal(_) => CliError::Failure(anyhow!("{}: {e}; please report this", args.sites.display())),
         e => CliError::BadInput(anyhow!("{}: {e}", args.sites.display())),
-    })?;
-    // The guarantees are checked before anything is written.
-    let check = check_crust(&crust.mesh).map_err(|e| {
-        CliError::Failure(anyhow!("{}: the crust failed its check ({e}); please report this", args.sites.display()))
-    })?;
-    let out = to_mesh_frame(&file, &crust.mesh);
-    mesh_io::write_mesh(&args.output, &out)?;
+    };
+    // Extraction checks the crust in the unit cube; `finalize` checks it again exactly as
+    // the file will hold it, before anything is written.
+    let mut crust = Crust::extract(&file.sites, &file.inside, &CrustConfig::default()).map_err(classify)?;
+    let precision = Precision::of_path(&args.output)?;
+    let written = finalize(&crust, file.transform, precision).map_err(classify)?;
+    let (out, check) = (&written.mesh, &written.check);
+    mesh_io::write_mesh(&args.output, out)?;
     let mut num_cells = 0;
     if let Some(path) = &args.cells {
         let cells = crust.cells().map_err(|e| CliError::Failure(e.into()))?;
@@ -77,7 +83,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         mesh_io::write_gltf(path, &scene, layout)?;
     }
     let s = &crust.stats;
-    let volume = mesh_io::TopologyReport::of(&out).signed_volume;
+    let volume = check.report.signed_volume;
     if args.json {
         let j = serde_json::json!({
             "sites": args.sites.display().to_string(),
@@ -90,6 +96,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "num_vertices": out.positions.len(),
             "num_triangles": out.triangles.len(),
             "num_split_vertices": s.num_split_vertices,
+            "num_merged_vertices": s.num_merged_vertices,
+            "output_precision": format!("{precision:?}").to_lowercase(),
+            "num_merged_in_output": written.num_merged_vertices,
+            "num_separated_in_output": written.num_separated_vertices,
             "num_cells": num_cells,
             "genus": check.report.genus,
             "num_components": check.report.num_components,
@@ -100,7 +110,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::output::out!("{}", serde_json::to_string_pretty(&j).map_err(anyhow::Error::from)?);
     } else {
         crate::output::out!(
-            "{}: {} sites ({} inside) -> crust of {} triangles, {} vertices, {} component(s), genus {}, volume {:.6e} (mesh units), closed and manifold, checked; {:.3} s.",
+            "{}: {} sites ({} inside) -> crust of {} triangles, {} vertices, {} component(s), genus {}, volume {:.6e} (mesh units), closed and manifold, checked as written; {:.3} s.",
             args.output.display(),
             s.num_sites,
             s.num_inside,

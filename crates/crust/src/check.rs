@@ -42,13 +42,16 @@ pub(crate) struct Defects {
     pub message: String,
     /// Triangle indices at fault (empty for a combinatorial failure).
     pub triangles: Vec<u32>,
+    /// Components and genus, when the mesh is closed, manifold and oriented.
+    pub topology: Option<(usize, i64)>,
 }
 
 /// [`check_crust`], reporting the triangles at fault; with `stop_at_first` false, every
 /// degenerate triangle and every meeting pair is listed.
 pub(crate) fn find_defects(mesh: &TriMesh, stop_at_first: bool) -> Result<CrustCheck, Defects> {
     let report = TopologyReport::of(mesh);
-    let fail = |message: String| Defects { message, triangles: Vec::new() };
+    let topology = report.genus.map(|g| (report.num_components, g));
+    let fail = |message: String| Defects { message, triangles: Vec::new(), topology };
     if mesh.triangles.is_empty() {
         return Ok(CrustCheck { report, num_pairs_tested: 0, num_adjacent_pairs_tested: 0 });
     }
@@ -72,6 +75,7 @@ pub(crate) fn find_defects(mesh: &TriMesh, stop_at_first: bool) -> Result<CrustC
                 degenerate.len()
             ),
             triangles: degenerate,
+            topology,
         });
     }
     if !(report.signed_volume > 0.0) {
@@ -83,6 +87,7 @@ pub(crate) fn find_defects(mesh: &TriMesh, stop_at_first: bool) -> Result<CrustC
         return Err(Defects {
             message: format!("triangles {a} and {b} {what} (exact test)"),
             triangles: scan.hits.iter().flat_map(|&(a, b)| [a as u32, b as u32]).collect(),
+            topology,
         });
     }
     Ok(CrustCheck { report, num_pairs_tested: scan.disjoint_tested, num_adjacent_pairs_tested: scan.adjacent_tested })
@@ -139,7 +144,8 @@ struct Scan {
 fn scan(mesh: &TriMesh, stop_at_first: bool, adjacent: bool) -> Scan {
     let n = mesh.triangles.len();
     let mut out = Scan { disjoint_tested: 0, adjacent_tested: 0, hits: Vec::new() };
-    let tri = |t: usize| mesh.triangles[t].map(|i| mesh.positions[i as usize]);
+    let corners: Vec<[V; 3]> = mesh.triangles.iter().map(|t| t.map(|i| mesh.positions[i as usize])).collect();
+    let tri = |t: usize| corners[t];
     let boxes: Vec<(V, V)> = (0..n)
         .map(|t| {
             let c = tri(t);
@@ -152,40 +158,82 @@ fn scan(mesh: &TriMesh, stop_at_first: bool, adjacent: bool) -> Scan {
         return out;
     }
     let skip: Vec<bool> = if adjacent { (0..n).map(|t| is_degenerate(mesh, t)).collect() } else { vec![false; n] };
+    // One id per distinct position (−0.0 and 0.0 alike), so that shared positions are found
+    // by comparing integers.
+    let mut id_of: std::collections::HashMap<[u64; 3], u32> =
+        std::collections::HashMap::with_capacity(mesh.positions.len());
+    let position_id: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let next = id_of.len() as u32;
+            *id_of.entry(p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })).or_insert(next)
+        })
+        .collect();
+    drop(id_of);
+    let pid: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| t.map(|i| position_id[i as usize])).collect();
     let (lo, hi) = mesh.bounding_box();
     let res = ((n as f64).cbrt().ceil() as usize).clamp(1, 512);
     let size = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / res as f64).max(f64::MIN_POSITIVE));
     let cell = |p: V, k: usize| (((p[k] - lo[k]) / size[k]) as usize).min(res - 1);
-    let mut buckets: std::collections::HashMap<(usize, usize, usize), Vec<u32>> = std::collections::HashMap::new();
-    for (t, (blo, bhi)) in boxes.iter().enumerate() {
-        if skip[t] {
-            continue;
-        }
-        for i in cell(*blo, 0)..=cell(*bhi, 0) {
-            for j in cell(*blo, 1)..=cell(*bhi, 1) {
-                for k in cell(*blo, 2)..=cell(*bhi, 2) {
-                    buckets.entry((i, j, k)).or_default().push(t as u32);
+    // Cells in (i, j, k) lexicographic order as one index; triangles bucketed by a
+    // counting sort (compressed rows).
+    let index = |i: usize, j: usize, k: usize| (i * res + j) * res + k;
+    let range = |t: usize| {
+        let (blo, bhi) = boxes[t];
+        [0, 1, 2].map(|k| (cell(blo, k), cell(bhi, k)))
+    };
+    let mut start = vec![0u32; res * res * res + 1];
+    for t in (0..n).filter(|&t| !skip[t]) {
+        let r = range(t);
+        for i in r[0].0..=r[0].1 {
+            for j in r[1].0..=r[1].1 {
+                for k in r[2].0..=r[2].1 {
+                    start[index(i, j, k) + 1] += 1;
                 }
             }
         }
     }
-    let mut keys: Vec<_> = buckets.keys().copied().collect();
-    keys.sort_unstable();
-    for key in keys {
-        let ts = &buckets[&key];
+    for c in 1..start.len() {
+        start[c] += start[c - 1];
+    }
+    let mut fill = start.clone();
+    let mut members = vec![0u32; start[start.len() - 1] as usize];
+    for t in (0..n).filter(|&t| !skip[t]) {
+        let r = range(t);
+        for i in r[0].0..=r[0].1 {
+            for j in r[1].0..=r[1].1 {
+                for k in r[2].0..=r[2].1 {
+                    let c = index(i, j, k);
+                    members[fill[c] as usize] = t as u32;
+                    fill[c] += 1;
+                }
+            }
+        }
+    }
+    for key in 0..res * res * res {
+        let ts = &mut members[start[key] as usize..start[key + 1] as usize];
+        // Sorted by the lower x of their boxes, so the scan of a triangle's partners stops
+        // at the first that starts beyond it.
+        ts.sort_unstable_by(|&a, &b| boxes[a as usize].0[0].total_cmp(&boxes[b as usize].0[0]).then(a.cmp(&b)));
+        let ts = &*ts;
         for (x, &a) in ts.iter().enumerate() {
             let (alo, ahi) = boxes[a as usize];
             for &b in &ts[x + 1..] {
                 let (blo, bhi) = boxes[b as usize];
-                if (0..3).any(|k| blo[k] > ahi[k] || bhi[k] < alo[k]) {
+                if blo[0] > ahi[0] {
+                    break;
+                }
+                if (1..3).any(|k| blo[k] > ahi[k] || bhi[k] < alo[k]) {
                     continue;
                 }
                 let corner = [0, 1, 2].map(|k| alo[k].max(blo[k]));
-                if (cell(corner, 0), cell(corner, 1), cell(corner, 2)) != key {
+                if index(cell(corner, 0), cell(corner, 1), cell(corner, 2)) != key {
                     continue; // tested in another cell
                 }
                 let (ta, tb) = (tri(a as usize), tri(b as usize));
-                let meet = if ta.iter().any(|p| tb.contains(p)) {
+                let (ia, ib) = (pid[a as usize], pid[b as usize]);
+                let meet = if ia.iter().any(|p| ib.contains(p)) {
                     if !adjacent {
                         continue;
                     }
@@ -211,26 +259,57 @@ fn scan(mesh: &TriMesh, stop_at_first: bool, adjacent: bool) -> Scan {
 /// Exact test for non-degenerate triangles that share one or more vertex positions: do
 /// they meet anywhere but at their shared vertices and the edge between them?
 pub fn adjacent_overlap(a: [V; 3], b: [V; 3]) -> bool {
-    let mut shared = Vec::with_capacity(3);
+    let mut shared = [(0usize, 0usize); 3];
+    let mut count = 0;
     for i in 0..3 {
         if let Some(j) = (0..3).find(|&j| b[j] == a[i]) {
-            shared.push((i, j));
+            shared[count] = (i, j);
+            count += 1;
         }
     }
-    match shared.len() {
+    let shared = &shared[..count];
+    match count {
         0 => triangles_intersect(a, b),
         1 => {
             let (i, j) = shared[0];
             let p = a[i];
             let (a1, a2) = (a[(i + 1) % 3], a[(i + 2) % 3]);
             let (b1, b2) = (b[(j + 1) % 3], b[(j + 2) % 3]);
-            // Both are convex and contain p, so they meet elsewhere iff the edge opposite p
-            // in one meets the other, or an edge at p runs into the other (then it lies in
-            // the other's plane, inside its angle at p).
+            // Their intersection is convex and holds p, so it holds more iff their angles at
+            // p overlap. First in a projection where both are non-degenerate (cheap and
+            // conclusive for the common case of neighbours in one plane, where orient3d
+            // needs its exact stages): if the projected angles are disjoint, so are the
+            // triangles beyond p.
+            let k = dominant_axis(a);
+            let pp = proj(p, k);
+            let [pa1, pa2, pb1, pb2] = [a1, a2, b1, b2].map(|x| proj(x, k));
+            let (sa, sb) = (o2(pp, pa1, pa2), o2(pp, pb1, pb2));
+            if sa != 0 && sb != 0 {
+                let in_a = |x| o2(pp, pa1, x) * sa >= 0 && o2(pp, x, pa2) * sa >= 0;
+                let in_b = |x| o2(pp, pb1, x) * sb >= 0 && o2(pp, x, pb2) * sb >= 0;
+                if !in_a(pb1) && !in_a(pb2) && !in_b(pa1) && !in_b(pa2) {
+                    return false;
+                }
+            }
+            // If a1 and a2 lie strictly on one side of b's
+            // plane, a meets that plane only at p (and likewise the other way round).
+            let (sa1, sa2) = (o3(p, b1, b2, a1), o3(p, b1, b2, a2));
+            if sa1 * sa2 > 0 {
+                return false;
+            }
+            let (sb1, sb2) = (o3(p, a1, a2, b1), o3(p, a1, a2, b2));
+            if sb1 * sb2 > 0 {
+                return false;
+            }
+            // Otherwise they meet elsewhere iff the edge opposite p in one meets the other,
+            // or an edge at p runs into the other (it then lies in the other's plane,
+            // inside its angle at p).
             segment_meets_triangle(a1, a2, b)
                 || segment_meets_triangle(b1, b2, a)
-                || [a1, a2].iter().any(|&x| o3(p, b1, b2, x) == 0 && in_angle(p, b1, b2, x))
-                || [b1, b2].iter().any(|&x| o3(p, a1, a2, x) == 0 && in_angle(p, a1, a2, x))
+                || (sa1 == 0 && in_angle(p, b1, b2, a1))
+                || (sa2 == 0 && in_angle(p, b1, b2, a2))
+                || (sb1 == 0 && in_angle(p, a1, a2, b1))
+                || (sb2 == 0 && in_angle(p, a1, a2, b2))
         }
         2 => {
             // A shared edge (p, q): the triangles meet elsewhere iff they are coplanar and
@@ -238,6 +317,12 @@ pub fn adjacent_overlap(a: [V; 3], b: [V; 3]) -> bool {
             let (p, q) = (a[shared[0].0], a[shared[1].0]);
             let x = a[(0..3).find(|&i| shared.iter().all(|s| s.0 != i)).unwrap_or(0)];
             let y = b[(0..3).find(|&j| shared.iter().all(|s| s.1 != j)).unwrap_or(0)];
+            // Strictly opposite sides in a projection: no fold, coplanar or not.
+            let k = dominant_axis(a);
+            let (sx, sy) = (o2(proj(p, k), proj(q, k), proj(x, k)), o2(proj(p, k), proj(q, k), proj(y, k)));
+            if sx * sy < 0 {
+                return false;
+            }
             if o3(p, q, x, y) != 0 {
                 return false;
             }
@@ -245,6 +330,20 @@ pub fn adjacent_overlap(a: [V; 3], b: [V; 3]) -> bool {
             o2(proj(p, k), proj(q, k), proj(x, k)) == o2(proj(p, k), proj(q, k), proj(y, k))
         }
         _ => true,
+    }
+}
+
+/// The axis along which triangle `t`'s (f64) normal is largest: dropping it gives a
+/// projection where `t` is not degenerate unless it is nearly so.
+fn dominant_axis(t: [V; 3]) -> usize {
+    let (u, v) = ([0, 1, 2].map(|k| t[1][k] - t[0][k]), [0, 1, 2].map(|k| t[2][k] - t[0][k]));
+    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    if n[0].abs() >= n[1].abs() && n[0].abs() >= n[2].abs() {
+        0
+    } else if n[1].abs() >= n[2].abs() {
+        1
+    } else {
+        2
     }
 }
 
@@ -375,5 +474,25 @@ mod tests {
         // Coplanar, overlapping and disjoint.
         assert!(triangles_intersect(t, [[0.1, 0.1, 0.], [2., 0.1, 0.], [0.1, 2., 0.]]));
         assert!(!triangles_intersect(t, [[1., 1., 0.], [2., 1., 0.], [1., 2., 0.]]));
+    }
+
+    #[test]
+    fn triangles_sharing_vertices_meet_only_there_unless_they_fold_or_cross() {
+        let (o, x, y, z) = ([0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]);
+        // A shared edge: opposite sides in one plane, a dihedral angle, a fold.
+        assert!(!adjacent_overlap([o, x, y], [x, o, [0., -1., 0.]]));
+        assert!(!adjacent_overlap([o, x, y], [x, o, z]));
+        assert!(adjacent_overlap([o, x, y], [x, o, [0.5, 0.5, 0.]]));
+        // One shared vertex: disjoint angles in one plane; overlapping angles; a shared
+        // ray; crossing through each other; an edge running into the other in its plane.
+        assert!(!adjacent_overlap([o, x, y], [o, [-1., 0., 0.], [0., -1., 0.]]));
+        assert!(adjacent_overlap([o, x, y], [o, [1., 1., 0.], [-1., 2., 0.]]));
+        assert!(adjacent_overlap([o, x, y], [o, [2., 0., 0.], [0., -1., 0.]]));
+        assert!(adjacent_overlap([o, x, y], [o, [0.3, 0.3, -1.], [0.3, 0.3, 1.]]));
+        assert!(adjacent_overlap([o, x, y], [o, [0.5, 0.2, 0.], z]));
+        assert!(!adjacent_overlap([o, x, y], [o, [-0.5, -0.2, 0.], z]));
+        assert!(!adjacent_overlap([o, x, y], [o, z, [-1., 0., 1.]]));
+        // The same triangle twice (either orientation).
+        assert!(adjacent_overlap([o, x, y], [o, y, x]));
     }
 }

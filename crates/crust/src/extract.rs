@@ -63,6 +63,9 @@ pub struct Crust {
     /// The exact checker's report on `mesh` ([`crate::check::check_crust`]), which it
     /// passed: extraction checks what it returns.
     pub check: CrustCheck,
+    /// The crust's polygons (Voronoi faces) as ids into `mesh.positions`, before
+    /// triangulation: what [`crate::output::finalize`] rounds.
+    pub(crate) faces: Vec<Vec<u32>>,
     /// The tetrahedralization and labels, kept for [`Crust::cells`].
     state: Option<State>,
 }
@@ -82,6 +85,11 @@ struct VoronoiVertices {
 }
 
 const NONE: u32 = u32::MAX;
+
+/// The largest crust-edge length merged to repair rounding, relative to the crust's
+/// largest extent: 2⁻²⁶ ≈ 1.5e-8, some ten million ulps of f64 and far above the clusters
+/// of nearly cospherical sites (a few hundred ulps at most in the tests).
+const MAX_MERGE: f64 = 1.0 / (1u64 << 26) as f64;
 
 impl VoronoiVertices {
     fn new(num_tets: usize) -> Self {
@@ -189,7 +197,7 @@ impl Crust {
             stats.total_seconds = start.elapsed().as_secs_f64();
             let mesh = TriMesh::default();
             let check = check_crust(&mesh).map_err(CrustError::Internal)?;
-            return Ok(Crust { mesh, stats, check, state: None });
+            return Ok(Crust { mesh, stats, check, faces: Vec::new(), state: None });
         }
 
         // Pass 1: which inside cells reach past which box faces.
@@ -258,11 +266,11 @@ impl Crust {
         stats.num_polygons = polygons.len();
         // The vertices are rounded circumcentres: check the mesh exactly, and where
         // rounding broke it (nearly degenerate sites), merge what f64 cannot keep apart.
-        let target = Target { round: |x| x, epsilon: f64::EPSILON, distinct_positions: false };
+        let target = Target { round: |x| x, epsilon: f64::EPSILON, distinct_positions: false, max_merge: MAX_MERGE };
         let (built, check) = match resolve::attempt(&polygons, &vv.positions, &target) {
             Ok((built, check, _)) => (built, check),
             Err(first) => {
-                let o = resolve::resolve(&polygons, &vv.positions, &target, first)?;
+                let o = resolve::resolve(&polygons, &vv.positions, &target, first, None)?;
                 stats.num_merged_vertices = o.num_merged;
                 stats.merge_distance = o.merge_distance;
                 (o.built, o.check)
@@ -271,7 +279,8 @@ impl Crust {
         stats.num_voronoi_vertices = built.num_used;
         stats.num_split_vertices = built.num_split;
         stats.total_seconds = start.elapsed().as_secs_f64();
-        Ok(Crust { mesh: built.mesh, stats, check, state: Some(State { dt, inside: vertex_inside, vv }) })
+        let faces = built.faces;
+        Ok(Crust { mesh: built.mesh, stats, check, faces, state: Some(State { dt, inside: vertex_inside, vv }) })
     }
 
     /// Every inside cell (clipped to the box) as a closed convex polyhedron, fan

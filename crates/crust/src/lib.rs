@@ -3,8 +3,9 @@
 //! Entry points: [`Crust::extract`] (the crust, the set of Voronoi faces between an inside
 //! and an outside site, as a closed oriented manifold [`mesh_io::TriMesh`]),
 //! [`Crust::cells`] (every inside cell as a closed convex polyhedron), [`check::check_crust`]
-//! (the exact checker of the guarantees), and [`SitesFile`] (the `.npz` sites format shared
-//! with training).
+//! (the exact checker of the guarantees), [`output::finalize`] (the crust exactly as a file
+//! in the mesh frame and the format's precision will hold it, repaired or refused, and
+//! checked), and [`SitesFile`] (the `.npz` sites format shared with training).
 //!
 //! The surface is "the boundary of (union of inside cells) ∩ box" of the VoronoiNet paper
 //! (Williams, Panozzo, Yi, Tagliasacchi), read off an exact Delaunay tetrahedralization

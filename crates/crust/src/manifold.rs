@@ -25,7 +25,6 @@ fn dot(a: V, b: V) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-
 /// Newell normal of a polygon (not normalised).
 fn newell(poly: &[u32], pos: &[V]) -> V {
     let mut n = [0.0; 3];
@@ -51,13 +50,28 @@ pub(crate) struct Built {
     /// Per mesh vertex: whether its position is computed (an edge midpoint or a polygon
     /// centroid) rather than copied.
     pub computed: Vec<bool>,
-    /// Per triangle: the polygon it triangulates.
-    pub face_of_triangle: Vec<u32>,
+    /// The polygons as mesh vertex ids (split copies and inserted midpoints included),
+    /// before triangulation.
+    pub faces: Vec<Vec<u32>>,
+}
+
+/// Why the polygons do not make a closed oriented manifold, and the polygon vertices at
+/// fault.
+#[derive(Debug)]
+pub(crate) struct BuildError {
+    pub message: String,
+    pub vertices: Vec<u32>,
+}
+
+impl From<BuildError> for CrustError {
+    fn from(e: BuildError) -> Self {
+        CrustError::Internal(e.message)
+    }
 }
 
 /// Build the mesh. `polygons`: oriented simple polygons (no vertex repeated) as ids into
 /// `positions` (#P×3 f64).
-pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, CrustError> {
+pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, BuildError> {
     // Half-edge h = offset[f] + i goes from polygons[f][i] to polygons[f][i + 1].
     let mut offset = Vec::with_capacity(polygons.len() + 1);
     let mut total = 0usize;
@@ -88,25 +102,39 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, Cru
     for h in 0..total {
         let (a, b) = (from(h), to(h));
         if a == b {
-            return Err(CrustError::Internal(format!("polygon {} repeats a vertex", face_of[h])));
+            return Err(BuildError { message: format!("polygon {} repeats a vertex", face_of[h]), vertices: vec![a] });
         }
         groups.entry((a.min(b), a.max(b))).or_default().push(h);
     }
     let mut twin = vec![usize::MAX; total];
+    // Every edge that cannot be paired, reported together (smallest edge first) so that the
+    // error does not depend on the map's order.
+    let mut failed: Vec<((u32, u32), String)> = Vec::new();
     for (&(u, v), hs) in &groups {
         let forward = hs.iter().filter(|&&h| from(h) == u).count();
         if forward * 2 != hs.len() {
-            return Err(CrustError::Internal(format!(
-                "Voronoi edge {u}-{v} has {forward} of {} half-edges one way: the crust would not be closed and oriented",
-                hs.len()
-            )));
+            failed.push((
+                (u, v),
+                format!(
+                    "Voronoi edge {u}-{v} has {forward} of {} half-edges one way: the crust would not be closed and oriented",
+                    hs.len()
+                ),
+            ));
+            continue;
         }
         if hs.len() == 2 {
             twin[hs[0]] = hs[1];
             twin[hs[1]] = hs[0];
             continue;
         }
-        pair_around_edge(u, v, hs, positions, polygons, &face_of, &mut twin)?;
+        if let Err(message) = pair_around_edge(u, v, hs, positions, polygons, &face_of, &mut twin) {
+            failed.push(((u, v), message));
+        }
+    }
+    if !failed.is_empty() {
+        failed.sort_unstable();
+        let message = format!("{} (and {} more edges)", failed[0].1, failed.len() - 1);
+        return Err(BuildError { message, vertices: failed.iter().flat_map(|((u, v), _)| [*u, *v]).collect() });
     }
 
     // Vertex umbrellas: the corner at the start of half-edge h continues, around its
@@ -136,7 +164,7 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, Cru
                 break;
             }
             if corner_vertex[h] != u32::MAX {
-                return Err(CrustError::Internal(format!("vertex {v}: umbrellas do not close")));
+                return Err(BuildError { message: format!("vertex {v}: umbrellas do not close"), vertices: vec![v] });
             }
         }
     }
@@ -200,9 +228,8 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, Cru
         }
         polys.push((ids, apex));
     }
-    let mut face_of_triangle: Vec<u32> = Vec::new();
     let mut tris = Vec::new();
-    for (fi, (ids, preferred)) in polys.iter().enumerate() {
+    for (ids, preferred) in &polys {
         tris.clear();
         if triangulate(ids, *preferred, &mesh.positions, &taken, &mut tris) {
             for &[a, b, c] in &tris {
@@ -223,10 +250,10 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, Cru
             }
         }
         mesh.triangles.extend_from_slice(&tris);
-        face_of_triangle.extend(std::iter::repeat_n(fi as u32, tris.len()));
     }
     let num_used = used.iter().filter(|&&u| u).count();
-    Ok(Built { mesh, num_used, num_split: copies, source, computed, face_of_triangle })
+    let faces = polys.into_iter().map(|(ids, _)| ids).collect();
+    Ok(Built { mesh, num_used, num_split: copies, source, computed, faces })
 }
 
 fn ukey(a: u32, b: u32) -> (u32, u32) {
@@ -237,7 +264,13 @@ fn ukey(a: u32, b: u32) -> (u32, u32) {
 /// into `out`: every triangle positively oriented in the projection along the polygon's
 /// dominant normal axis (exact orient2d), no new edge in `taken`. `false` when neither a
 /// fan (from `preferred` first) nor ear clipping finds one.
-fn triangulate(ids: &[u32], preferred: usize, positions: &[V], taken: &HashSet<(u32, u32)>, out: &mut Vec<[u32; 3]>) -> bool {
+fn triangulate(
+    ids: &[u32],
+    preferred: usize,
+    positions: &[V],
+    taken: &HashSet<(u32, u32)>,
+    out: &mut Vec<[u32; 3]>,
+) -> bool {
     let n = ids.len();
     if n == 3 {
         out.push([ids[0], ids[1], ids[2]]);
@@ -288,7 +321,9 @@ fn triangulate(ids: &[u32], preferred: usize, positions: &[V], taken: &HashSet<(
                     return true;
                 }
                 let q = pt(v);
-                !(robust::orient2d(pa, pb, q) >= 0.0 && robust::orient2d(pb, pc, q) >= 0.0 && robust::orient2d(pc, pa, q) >= 0.0)
+                !(robust::orient2d(pa, pb, q) >= 0.0
+                    && robust::orient2d(pb, pc, q) >= 0.0
+                    && robust::orient2d(pc, pa, q) >= 0.0)
             })
         });
         let Some(i) = ear else {
@@ -317,7 +352,7 @@ fn pair_around_edge(
     polygons: &[Vec<u32>],
     face_of: &[u32],
     twin: &mut [usize],
-) -> Result<(), CrustError> {
+) -> Result<(), String> {
     let pu = positions[u as usize];
     let axis = sub(positions[v as usize], pu);
     // An orthonormal-ish frame (e1, e2) perpendicular to the axis.
@@ -358,15 +393,13 @@ fn pair_around_edge(
         }
         let (_, other_ccw, g) = items[(i + 1) % m];
         if other_ccw {
-            return Err(CrustError::Internal(format!(
-                "faces around Voronoi edge {u}-{v} do not alternate inside/outside"
-            )));
+            return Err(format!("faces around Voronoi edge {u}-{v} do not alternate inside/outside"));
         }
         twin[h] = g;
         twin[g] = h;
     }
     if hs.iter().any(|&h| twin[h] == usize::MAX) {
-        return Err(CrustError::Internal(format!("could not pair the faces around Voronoi edge {u}-{v}")));
+        return Err(format!("could not pair the faces around Voronoi edge {u}-{v}"));
     }
     Ok(())
 }

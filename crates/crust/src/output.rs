@@ -10,7 +10,7 @@
 //! (inside cells touching along an edge or at a point share a position) weld into
 //! non-manifold vertices. [`finalize`] produces the mesh exactly as it will be written and
 //! read, repairs it where rounding broke it, and checks it with
-//! [`check_crust`](crate::check::check_crust); it never returns a mesh that fails.
+//! [`check_crust`]; it never returns a mesh that fails.
 
 use std::path::Path;
 
@@ -18,6 +18,7 @@ use mesh_io::{OutputFormat, TriMesh, UnitCubeTransform};
 
 use crate::check::{check_crust, find_defects, CrustCheck};
 use crate::error::CrustError;
+use crate::extract::Crust;
 use crate::resolve::{attempt, coincident_groups, resolve, split_loops, Target};
 
 /// How a format stores coordinates.
@@ -57,8 +58,19 @@ impl Precision {
 
     fn target(self) -> Target {
         match self {
-            Precision::F32 => Target { round: |x| x as f32 as f64, epsilon: f32::EPSILON as f64, distinct_positions: true },
-            Precision::F64 => Target { round: |x| x, epsilon: f64::EPSILON, distinct_positions: true },
+            // f32: merging up to 2⁻¹⁶ of the extent, some 128 ulps at the mesh's own scale.
+            Precision::F32 => Target {
+                round: |x| x as f32 as f64,
+                epsilon: f32::EPSILON as f64,
+                distinct_positions: true,
+                max_merge: 1.0 / (1u64 << 16) as f64,
+            },
+            Precision::F64 => Target {
+                round: |x| x,
+                epsilon: f64::EPSILON,
+                distinct_positions: true,
+                max_merge: 1.0 / (1u64 << 26) as f64,
+            },
         }
     }
 }
@@ -118,9 +130,14 @@ impl FrameMap {
             FrameMap::Identity => false,
             FrameMap::UnitCube(t) => !(t.scale.is_finite() && t.scale != 0.0 && t.center.iter().all(|c| c.is_finite())),
             FrameMap::Matrix(m) => {
+                // The determinant of the matrix scaled to entries of at most 1, so that it
+                // neither overflows nor underflows for any finite matrix.
+                let s = m.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
+                let scaled = m.map(|row| row.map(|x| x / s));
                 !(m.iter().flatten().all(|x| x.is_finite())
                     && m[3] == [0.0, 0.0, 0.0, 1.0]
-                    && linear_determinant(m).is_normal())
+                    && s > 0.0
+                    && linear_determinant(&scaled) != 0.0)
             }
         };
         if bad {
@@ -143,7 +160,7 @@ pub struct Finalized {
     /// The mesh to write: every position is exactly representable in the output's
     /// precision (the writer stores it unchanged), distinct vertices have distinct
     /// positions (a reader's welding changes nothing), and it passes
-    /// [`check_crust`](crate::check::check_crust).
+    /// [`check_crust`].
     pub mesh: TriMesh,
     /// The exact check of `mesh`.
     pub check: CrustCheck,
@@ -161,7 +178,9 @@ pub struct Finalized {
 
 /// The crust exactly as a file in `precision` will hold it, checked.
 ///
-/// - `mesh`: a crust in the unit cube (for example [`crate::Crust::mesh`]), f64;
+/// - `crust`: as extracted, in the unit cube; its polygons (Voronoi faces) are rounded and
+///   triangulated again, so that rounding that flattens a polygon's corner does not leave a
+///   degenerate triangle;
 /// - `map`: to the output's frame ([`FrameMap`]; a [`UnitCubeTransform`], a 4×4 matrix,
 ///   or the identity); triangles are reversed when it mirrors;
 /// - `precision`: of the format ([`Precision::of_path`], [`Precision::of_format`]).
@@ -181,8 +200,29 @@ pub struct Finalized {
 /// as a scale of 1e300 with f32), or when rounding breaks the crust beyond repair (too
 /// coarse a precision for the mesh's detail; write OBJ or PLY instead). Never a mesh that
 /// fails the check.
-pub fn finalize(mesh: &TriMesh, map: impl Into<FrameMap>, precision: Precision) -> Result<Finalized, CrustError> {
-    let map = map.into();
+pub fn finalize(crust: &Crust, map: impl Into<FrameMap>, precision: Precision) -> Result<Finalized, CrustError> {
+    finalize_polygons(&crust.mesh, Some(&crust.faces), map.into(), precision)
+}
+
+/// [`finalize`] for a crust given only as a triangle mesh (in the unit cube, passing
+/// [`check_crust`]): the same, with each triangle as a polygon.
+/// Where rounding flattens triangles it repairs less often than [`finalize`] and refuses
+/// instead.
+///
+/// # Errors
+/// As [`finalize`].
+pub fn finalize_mesh(mesh: &TriMesh, map: impl Into<FrameMap>, precision: Precision) -> Result<Finalized, CrustError> {
+    finalize_polygons(mesh, None, map.into(), precision)
+}
+
+/// `faces`: polygons over `mesh.positions` that `mesh.triangles` triangulates (`None`: the
+/// triangles themselves).
+fn finalize_polygons(
+    mesh: &TriMesh,
+    faces: Option<&[Vec<u32>]>,
+    map: FrameMap,
+    precision: Precision,
+) -> Result<Finalized, CrustError> {
     map.check()?;
     let mut positions = Vec::with_capacity(mesh.positions.len());
     for (i, p) in mesh.positions.iter().enumerate() {
@@ -205,9 +245,12 @@ pub fn finalize(mesh: &TriMesh, map: impl Into<FrameMap>, precision: Precision) 
         }
         positions.push(q);
     }
+    let expect = {
+        let r = mesh_io::TopologyReport::of(mesh);
+        r.genus.map(|g| (r.num_components, g))
+    };
     let flip = map.mirrors();
-    let triangles: Vec<[u32; 3]> =
-        mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect();
+    let triangles: Vec<[u32; 3]> = mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect();
     let out = TriMesh { positions, triangles };
     if out.triangles.is_empty() {
         let check = check_crust(&TriMesh::default()).map_err(CrustError::Internal)?;
@@ -222,33 +265,63 @@ pub fn finalize(mesh: &TriMesh, map: impl Into<FrameMap>, precision: Precision) 
     // Rounding broke nothing: the mapped mesh itself.
     if coincident_groups(&out).is_empty() {
         if let Ok(check) = find_defects(&out, true) {
-            return Ok(Finalized { mesh: out, check, num_merged_vertices: 0, merge_distance: 0.0, num_separated_vertices: 0 });
+            return Ok(Finalized {
+                mesh: out,
+                check,
+                num_merged_vertices: 0,
+                merge_distance: 0.0,
+                num_separated_vertices: 0,
+            });
         }
     }
     // Weld as a reader will, rebuild, and repair what remains.
     let mut first_at: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
-    let weld: Vec<u32> =
-        (0..out.positions.len() as u32).map(|v| *first_at.entry(out.positions[v as usize].map(f64::to_bits)).or_insert(v)).collect();
+    let weld: Vec<u32> = (0..out.positions.len() as u32)
+        .map(|v| *first_at.entry(out.positions[v as usize].map(f64::to_bits)).or_insert(v))
+        .collect();
     let num_welded = weld.iter().enumerate().filter(|&(v, &w)| w as usize != v).count();
-    let triangles: Vec<Vec<u32>> = out.triangles.iter().map(|t| t.to_vec()).collect();
-    let polygons = split_loops(&triangles, &weld);
+    let mut polygons: Vec<Vec<u32>> = match faces {
+        Some(f) => f.to_vec(),
+        None => mesh.triangles.iter().map(|t| t.to_vec()).collect(),
+    };
+    if flip {
+        polygons.iter_mut().for_each(|p| p.reverse());
+    }
+    let polygons = split_loops(&polygons, &weld);
     let target = precision.target();
     let unwritable = |e: CrustError| {
+        let why = match e {
+            CrustError::Internal(m) => m,
+            e => e.to_string(),
+        };
         CrustError::Unwritable(format!(
-            "rounding the crust to {precision:?} in the output frame breaks it beyond repair ({e}); \
-             write a lossless format (.obj or .ply) instead"
+            "rounding the crust to {} in the output frame breaks it beyond repair ({why}); write a lossless format \
+             (.obj or .ply) instead",
+            match precision {
+                Precision::F32 => "float32",
+                Precision::F64 => "float64",
+            }
         ))
     };
     match attempt(&polygons, &out.positions, &target) {
-        Ok((built, check, num_separated)) => Ok(Finalized {
-            mesh: compact(built.mesh),
-            check,
-            num_merged_vertices: num_welded,
-            merge_distance: 0.0,
-            num_separated_vertices: num_separated,
-        }),
+        Ok((built, check, num_separated))
+            if expect.is_none_or(|(c, g)| (check.report.num_components, check.report.genus) == (c, Some(g))) =>
+        {
+            Ok(Finalized {
+                mesh: compact(built.mesh),
+                check,
+                num_merged_vertices: num_welded,
+                merge_distance: 0.0,
+                num_separated_vertices: num_separated,
+            })
+        }
+        Ok((_, check, _)) => Err(unwritable(CrustError::Internal(format!(
+            "welding the vertices that rounding makes coincident changes the topology from {:?} to {} component(s) \
+             of genus {:?}",
+            expect, check.report.num_components, check.report.genus
+        )))),
         Err(first) => {
-            let o = resolve(&polygons, &out.positions, &target, first).map_err(unwritable)?;
+            let o = resolve(&polygons, &out.positions, &target, first, expect).map_err(unwritable)?;
             Ok(Finalized {
                 mesh: compact(o.built.mesh),
                 check: o.check,

@@ -45,6 +45,8 @@ pub(crate) struct Target {
     pub epsilon: f64,
     /// Whether distinct vertices need distinct positions (a file: readers weld).
     pub distinct_positions: bool,
+    /// The largest merge distance tried, relative to the largest extent of the mesh.
+    pub max_merge: f64,
 }
 
 /// A valid mesh and what it took.
@@ -64,33 +66,30 @@ pub(crate) struct Outcome {
 pub(crate) struct Failure {
     pub message: String,
     pub bad: Option<Vec<u32>>,
+    /// Components and genus of the mesh built, when it was closed, manifold and oriented.
+    pub topology: Option<(usize, i64)>,
 }
 
 /// Displacements tried, in units in the last place, for separating coincident copies.
 const SEPARATION_STEPS: [f64; 5] = [4.0, 16.0, 64.0, 256.0, 1024.0];
 
 /// Build and check the polygons as they are.
-pub(crate) fn attempt(polygons: &[Vec<u32>], positions: &[V], target: &Target) -> Result<(Built, CrustCheck, usize), Failure> {
-    let dbg = std::env::var_os("CRUST_DEBUG").is_some();
-    let mut built = manifold::build(polygons, positions).map_err(|e| Failure { message: e.to_string(), bad: None })?;
+pub(crate) fn attempt(
+    polygons: &[Vec<u32>],
+    positions: &[V],
+    target: &Target,
+) -> Result<(Built, CrustCheck, usize), Failure> {
+    let mut built = manifold::build(polygons, positions).map_err(|e| Failure {
+        message: e.message,
+        bad: Some(e.vertices),
+        topology: None,
+    })?;
     for (p, &m) in built.mesh.positions.iter_mut().zip(&built.computed) {
         if m {
             *p = p.map(target.round);
         }
     }
-    let defects_to_failure = |built: &Built, d: crate::check::Defects| {
-        if std::env::var_os("CRUST_DEBUG").is_some() {
-            for &t in d.triangles.iter().take(2) {
-                let tri = built.mesh.triangles[t as usize];
-                let f = built.face_of_triangle[t as usize] as usize;
-                eprintln!("  tri {t} {tri:?} src {:?} face {f} = {:?}", tri.map(|v| built.source[v as usize]), polygons[f]);
-                let _ = dbg;
-                for v in tri {
-                    eprintln!("     {:?}", built.mesh.positions[v as usize]);
-                }
-            }
-        }
-        Failure {
+    let defects_to_failure = |built: &Built, d: crate::check::Defects| Failure {
         bad: (!d.triangles.is_empty()).then(|| {
             d.triangles
                 .iter()
@@ -99,7 +98,8 @@ pub(crate) fn attempt(polygons: &[Vec<u32>], positions: &[V], target: &Target) -
                 .collect()
         }),
         message: d.message,
-    }};
+        topology: d.topology,
+    };
     let groups = if target.distinct_positions { coincident_groups(&built.mesh) } else { Vec::new() };
     if groups.is_empty() {
         return match find_defects(&built.mesh, false) {
@@ -128,7 +128,11 @@ pub(crate) fn attempt(polygons: &[Vec<u32>], positions: &[V], target: &Target) -
     built.mesh.positions = original;
     let mut failure = match first_failure {
         Some(d) => defects_to_failure(&built, d),
-        None => Failure { message: "coincident vertices could not be moved apart".into(), bad: Some(Vec::new()) },
+        None => Failure {
+            message: "coincident vertices could not be moved apart".into(),
+            bad: Some(Vec::new()),
+            topology: None,
+        },
     };
     if let Some(bad) = &mut failure.bad {
         bad.extend(groups.iter().flatten().map(|&v| built.source[v as usize]));
@@ -147,14 +151,18 @@ pub(crate) fn attempt(polygons: &[Vec<u32>], positions: &[V], target: &Target) -
 /// - `positions`: #P×3, already in the output's precision.
 ///
 /// # Errors
-/// [`CrustError::Internal`] naming the last defect when no merge distance up to 2⁻¹⁶ of
-/// the bounding-box diagonal gives a valid mesh.
+/// [`CrustError::Internal`] naming the last defect when no merge distance up to
+/// `target.max_merge` of the mesh's largest extent gives a valid mesh, or when the only
+/// valid meshes found change the number of components or the genus of `first` (then the
+/// merging would have collapsed real features, not rounding noise).
 pub(crate) fn resolve(
     polygons: &[Vec<u32>],
     positions: &[V],
     target: &Target,
     first: Failure,
+    expect: Option<(usize, i64)>,
 ) -> Result<Outcome, CrustError> {
+    let expect = expect.or(first.topology);
     let n = positions.len();
     let max_abs = positions.iter().flatten().fold(0.0f64, |m, &c| m.max(c.abs()));
     let mut lo = [f64::INFINITY; 3];
@@ -167,7 +175,9 @@ pub(crate) fn resolve(
     }
     let diagonal = (0..3).map(|k| (hi[k] - lo[k]).max(0.0)).fold(0.0f64, f64::max);
     let unit = (max_abs * target.epsilon).max(f64::MIN_POSITIVE);
-    let cap = (diagonal * 2f64.powi(-16)).max(64.0 * unit);
+    // Up to `max_merge` of the extent, and at least 16 units in the last place (a mesh far
+    // from the origin compared with its size has few of them across it).
+    let cap = (diagonal * target.max_merge).max(16.0 * unit);
     let mut levels = vec![0.0];
     let mut t = unit;
     while t <= cap {
@@ -203,15 +213,21 @@ pub(crate) fn resolve(
             let loops = split_loops(polygons, &rep);
             match attempt(&loops, positions, target) {
                 Ok((built, check, num_separated)) => {
+                    let got = (check.report.num_components, check.report.genus);
+                    if let Some((c, g)) = expect {
+                        if got != (c, Some(g)) {
+                            return Err(CrustError::Internal(format!(
+                                "rounding the crust's vertices breaks it, and the merging that repairs it \
+                                 (vertices up to {tol:.3e} apart) changes its topology from {c} component(s) of \
+                                 genus {g} to {} of genus {:?}",
+                                got.0, got.1
+                            )));
+                        }
+                    }
                     let num_merged = rep.iter().enumerate().filter(|&(v, &r)| r as usize != v).count();
                     return Ok(Outcome { built, check, num_merged, merge_distance: tol, num_separated });
                 }
                 Err(f) => {
-                    if std::env::var_os("CRUST_DEBUG").is_some() {
-                        let nm = rep.iter().enumerate().filter(|&(v, &r)| r as usize != v).count();
-                        let nb = bad.iter().filter(|&&b| b).count();
-                        eprintln!("tol {tol:e}: merged {nm}, bad {nb}, loops {}: {}", loops.len(), f.message);
-                    }
                     mark(&mut bad, &f);
                     last_message = f.message;
                 }
