@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-
 use crate::arrays::{read_points_npy, rows_array, write_npy};
 use crate::cli_error::{CliError, InFile};
 use delaunay3::Delaunay3;

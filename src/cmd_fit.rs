@@ -37,9 +37,10 @@ pub struct Args {
     /// Settings preset: `default` (measured best here) or `paper` (the seed paper's).
     #[arg(long, default_value = "default", value_parser = ["default", "paper"])]
     pub preset: String,
-    /// Initialisation: `surface` (pairs of sites straddling the surface; default), `samples`
-    /// (sites drawn from the labelled training samples) or `paper` (uniform, half inside,
-    /// half outside).
+    /// Initialisation: `pairs` (mirrored pairs at well-spread surface points, denser where
+    /// the part is thin; default), `surface` (pairs at random surface points, the previous
+    /// default), `samples` (sites drawn from the labelled training samples) or `paper`
+    /// (uniform, half inside, half outside).
     #[arg(long)]
     pub init: Option<Init>,
     /// Training samples per step.
@@ -51,8 +52,8 @@ pub struct Args {
     /// Anneal β geometrically from this value to 10,000 over the first half of training.
     #[arg(long)]
     pub beta_start: Option<f64>,
-    /// Surface initialisation: each site's distance from the surface, as a fraction of the
-    /// spacing of the pairs.
+    /// Pair initialisations: each site's distance from the surface, as a fraction of the
+    /// (local) spacing of the pairs.
     #[arg(long)]
     pub surface_offset: Option<f64>,
     /// Weight of the signed-distance regulariser.
@@ -61,6 +62,16 @@ pub struct Args {
     /// Weight of the centroidal regulariser.
     #[arg(long)]
     pub w_centroidal: Option<f64>,
+    /// Weight of the normal alignment inside the surface term.
+    #[arg(long)]
+    pub w_normal: Option<f64>,
+    /// Weight of the reconstruction (occupancy) loss E|O − V|.
+    #[arg(long)]
+    pub w_reconstruction: Option<f64>,
+    /// Weight of the surface term (surface samples pulled onto the bisector of their
+    /// nearest inside and outside sites).
+    #[arg(long)]
+    pub w_surface: Option<f64>,
     /// Size of the training sample pool (half uniform in the cube, half near the surface).
     #[arg(long, default_value_t = 1_000_000)]
     pub samples: usize,
@@ -124,6 +135,7 @@ fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
     c.eval.samples = args.eval_samples;
     c.checkpointing = Some(Checkpointing { path: out.checkpoint.clone(), every: args.checkpoint_every });
     c.preset = args.preset.clone();
+    c.output_precision = crust::output::Precision::of_path(&out.mesh)?;
     if let Some(p) = &args.resume {
         return Ok(c.resume(p)?);
     }
@@ -140,6 +152,9 @@ fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
     t.surface_offset = args.surface_offset.unwrap_or(t.surface_offset);
     t.weights.signed_distance = args.w_sdf.unwrap_or(t.weights.signed_distance);
     t.weights.centroidal = args.w_centroidal.unwrap_or(t.weights.centroidal);
+    t.weights.surface = args.w_surface.unwrap_or(t.weights.surface);
+    t.weights.reconstruction = args.w_reconstruction.unwrap_or(t.weights.reconstruction);
+    t.weights.normal = args.w_normal.unwrap_or(t.weights.normal);
     c.train = t;
     let c = c.with_seed(args.seed);
     c.validate()?;

@@ -4,7 +4,6 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-
 use crate::arrays::{read_points_npy, vec_array, Npz};
 use crate::cli_error::{CliError, InFile};
 use occupancy::{Config, MeshOracle, WindingMode};

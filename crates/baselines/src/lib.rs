@@ -31,7 +31,7 @@ pub use error::{BaselineError, Result};
 pub use mc::{extract_mesh, marching_cubes, Ambiguity, Inside, McOptions, DEFAULT_GRID_RES};
 pub use mlp::{Decoder, DecoderConfig, DecoderKind, Mlp};
 pub use scalar::Real;
-pub use vf_common::AdamParams;
 pub use train::{
     loss_and_grad, train, GradEngine, Schedule, StepRecord, TrainConfig, TrainReport, Trainer, TrainingData,
 };
+pub use vf_common::AdamParams;

@@ -13,8 +13,8 @@ use ndarray::{s, Array3, ArrayView2, ArrayViewMut2};
 use rayon::prelude::*;
 
 use crate::error::{config_err, BaselineError, Result};
-use vf_common::rng::{SplitMix64, Stream};
 use crate::scalar::Real;
+use vf_common::rng::{SplitMix64, Stream};
 
 /// Which decoder and loss.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

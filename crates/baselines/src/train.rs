@@ -19,9 +19,9 @@ use rayon::prelude::*;
 
 use crate::error::{config_err, BaselineError, Result};
 use crate::mlp::{DecoderKind, Mlp, Workspace};
+use crate::scalar::Real;
 use vf_common::rng::{SplitMix64, Stream};
 use vf_common::AdamParams;
-use crate::scalar::Real;
 
 /// Training samples: points with occupancy (OccNet) and/or signed-distance (DeepSDF)
 /// targets, one per point. Make them with the `occupancy` crate's samplers and oracle, or
@@ -86,7 +86,6 @@ pub enum Schedule {
         min_lr: f64,
     },
 }
-
 
 /// How to train.
 #[derive(Clone, Debug, PartialEq)]

@@ -55,7 +55,9 @@ impl NpzOut {
         S: Data<Elem = A>,
         D: Dimension,
     {
-        self.writer.add_array(name, array).map_err(|e| NpzError::Encode(format!("cannot encode array {name} ({e})")))?;
+        self.writer
+            .add_array(name, array)
+            .map_err(|e| NpzError::Encode(format!("cannot encode array {name} ({e})")))?;
         Ok(self)
     }
 

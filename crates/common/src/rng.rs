@@ -26,8 +26,8 @@ pub enum Stream {
     SitesInit = 101,
     /// soft-voronoi: the training batches.
     TrainBatch = 102,
-    /// fit: the seeded jitter of a crust retry.
-    CrustJitter = 201,
+    /// soft-voronoi: the surface-term batches.
+    SurfaceBatch = 103,
     /// study: the sphere's training data.
     StudySphereData = 301,
     /// study: the sphere's Chamfer samples.
@@ -181,7 +181,10 @@ mod tests {
         let d = ChunkRng::for_raw_stream(8, 0, 0).next_u64();
         assert!(a != b && a != c && a != d && b != c);
         assert_eq!(a, ChunkRng::for_raw_stream(7, 0, 0).next_u64());
-        assert_eq!(ChunkRng::for_chunk(7, Stream::SampleUniform, 0).next_u64(), ChunkRng::for_raw_stream(7, 1, 0).next_u64());
+        assert_eq!(
+            ChunkRng::for_chunk(7, Stream::SampleUniform, 0).next_u64(),
+            ChunkRng::for_raw_stream(7, 1, 0).next_u64()
+        );
     }
 
     #[test]
@@ -193,7 +196,7 @@ mod tests {
             SampleNearSurface,
             SitesInit,
             TrainBatch,
-            CrustJitter,
+            SurfaceBatch,
             StudySphereData,
             StudyChamfer,
             MlpBatch,

@@ -65,6 +65,9 @@ pub struct FitConfig {
     /// A saved state to continue from (see [`FitConfig::resume`]), with its path for
     /// messages.
     pub resume: Option<(TrainState, String)>,
+    /// How the crust will be stored (f32 for glTF, f64 for OBJ/PLY): the crust is rounded
+    /// to it and checked as rounded.
+    pub output_precision: crust::output::Precision,
     /// Skip the metrics against the input (Hausdorff, Chamfer, IoU): for callers that
     /// measure themselves.
     pub skip_metrics: bool,
@@ -87,6 +90,7 @@ impl FitConfig {
             eval: EvalSampling { samples: 1_000_000, sigmas: vec![0.01] },
             checkpointing: None,
             resume: None,
+            output_precision: crust::output::Precision::F32,
             skip_metrics: false,
         }
     }

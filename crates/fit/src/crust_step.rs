@@ -1,64 +1,49 @@
-//! The crust of trained sites, checked, with the retry policy shared by the main job and
-//! the sphere study.
+//! The crust of trained sites, checked exactly, and the mesh that will be written: mapped
+//! to the input's frame and rounded as the output format stores it, checked again.
 
-use crust::check::{check_crust, CrustCheck};
+use crust::check::CrustCheck;
+use crust::output::{finalize, Finalized, FrameMap, Precision};
 use crust::{Crust, CrustConfig};
-use mesh_io::{TriMesh, UnitCubeTransform};
-use vf_common::rng::{ChunkRng, Stream};
 
 use crate::error::FitError;
 
-/// A crust that passed the exact check.
+/// A crust that passed the exact check, and its written form.
 pub struct CheckedCrust {
-    /// The crust in the unit cube.
+    /// The crust in the unit cube (its `check` is the exact check of extraction).
     pub crust: Crust,
-    /// The exact check's report (closed, manifold, no self-intersections).
-    pub check: CrustCheck,
-    /// Jittered retries needed (0 almost always).
-    pub retries: usize,
+    /// The crust mapped to the input's frame and rounded to the output precision, checked
+    /// exactly again after rounding (repaired or refused where rounding broke it).
+    pub written: Finalized,
 }
 
 impl CheckedCrust {
-    /// The crust mapped to the input's frame (orientation kept when the transform
-    /// mirrors).
-    pub fn in_frame(&self, transform: &UnitCubeTransform) -> TriMesh {
-        transform.mesh_from_unit(&self.crust.mesh)
+    /// The exact check of the mesh as written.
+    pub fn check(&self) -> &CrustCheck {
+        &self.written.check
     }
 }
 
-/// The checked crust of `sites` (K×3, unit cube) with `labels`.
+/// The checked crust of `sites` (K×3, unit cube) with `labels`, and its form in the
+/// frame `map` takes it to (the input's: its `UnitCubeTransform`) at `precision` (f32 for
+/// glTF, f64 for OBJ/PLY).
 ///
-/// The crust is exact for the sites, but its Voronoi vertices are rounded to f64 in the
-/// output; where trained sites are nearly cospherical, distinct vertices can round onto
-/// each other and the exact checker rejects the mesh. Then the sites are moved by a seeded
-/// jitter far below their spacing (1e-9, then 1e-7 of the unit cube, stream
-/// [`Stream::CrustJitter`]) and the crust is extracted again; `sites` is updated, so a
-/// sites file written from it reproduces the crust.
+/// Extraction checks its own result exactly and resolves clusters of Voronoi vertices that
+/// f64 cannot tell apart (mirrored pairs make many); no site is moved.
 ///
 /// # Errors
-/// [`FitError::Failure`] with the crust's error, or the check's after two retries.
-pub fn crust_of(sites: &mut [[f64; 3]], labels: &[bool], seed: u64) -> Result<CheckedCrust, FitError> {
-    let mut retries = 0;
-    loop {
-        let attempt = Crust::extract(sites, labels, &CrustConfig::default())
-            .map_err(|e| FitError::Failure(format!("crust of the trained sites: {e}")))
-            .and_then(|c| match check_crust(&c.mesh) {
-                Ok(check) => Ok((c, check)),
-                Err(e) => Err(FitError::Failure(format!("the crust failed its check ({e}); please report this"))),
-            });
-        match attempt {
-            Ok((crust, check)) => return Ok(CheckedCrust { crust, check, retries }),
-            Err(e) if retries >= 2 => return Err(e),
-            Err(_) => {
-                retries += 1;
-                let amplitude = if retries == 1 { 1e-9 } else { 1e-7 };
-                let mut rng = ChunkRng::for_chunk(seed, Stream::CrustJitter, retries as u64);
-                for p in sites.iter_mut() {
-                    for x in p.iter_mut() {
-                        *x = (*x + amplitude * (2.0 * rng.uniform() - 1.0)).clamp(1e-9, 1.0 - 1e-9);
-                    }
-                }
-            }
-        }
-    }
+/// [`FitError::Failure`] when the crust cannot be extracted; [`FitError::Input`] when the
+/// rounded output cannot be made valid (coordinates beyond float32, for example).
+pub fn crust_of(
+    sites: &[[f64; 3]],
+    labels: &[bool],
+    map: impl Into<FrameMap>,
+    precision: Precision,
+) -> Result<CheckedCrust, FitError> {
+    let crust = Crust::extract(sites, labels, &CrustConfig::default())
+        .map_err(|e| FitError::Failure(format!("crust of the trained sites: {e}")))?;
+    let written = finalize(&crust, map, precision).map_err(|e| match e {
+        crust::CrustError::Internal(_) => FitError::Failure(format!("the crust as written: {e}")),
+        e => FitError::Input(format!("the crust as written: {e}")),
+    })?;
+    Ok(CheckedCrust { crust, written })
 }

@@ -7,7 +7,8 @@
 //! unit cube ([`data`]); build the occupancy oracle; sample and label the training pool by
 //! the workspace's one inside rule ([`occupancy::Config::is_inside_winding`]); train the
 //! sites with the soft-Voronoi ([`soft_voronoi::Trainer`]), checkpointing as asked; extract
-//! and check the crust with its retry policy ([`crust_of`]) and map it back; measure the
+//! and check the crust, map it back and round it as the output stores it, checked again
+//! ([`crust_of`]); measure the
 //! misclassification on fresh samples and the `eval` metrics against the input.
 //!
 //! # Example

@@ -118,7 +118,7 @@ pub struct QualityReport {
     pub eval_near_surface_sigmas: Vec<f64>,
 }
 
-/// The crust as written.
+/// The crust as written (every figure is of the mesh in the output file).
 #[derive(Clone, Debug, Serialize)]
 pub struct CrustReport {
     /// Sites (trainable and boundary).
@@ -127,8 +127,13 @@ pub struct CrustReport {
     pub num_inside: usize,
     /// Sites the projection into the cube moved.
     pub num_sites_projected_into_cube: usize,
-    /// Jittered retries of the crust.
-    pub jitter_retries: usize,
+    /// Voronoi vertices extraction merged (clusters f64 cannot tell apart).
+    pub num_merged_vertices: usize,
+    /// Vertices merged when rounding to the output precision.
+    pub num_merged_in_output: usize,
+    /// Split-vertex copies moved a few ulps apart in the output (so readers that weld
+    /// coincident vertices keep the mesh manifold).
+    pub num_separated_in_output: usize,
     /// Vertices.
     pub num_vertices: usize,
     /// Triangles.

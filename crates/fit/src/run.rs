@@ -17,10 +17,11 @@ use crate::report::*;
 
 /// What a fit produces.
 pub struct FitOutput {
-    /// The trained sites (trainable then boundary; unit-cube coordinates, moved by the
-    /// crust's jitter if it retried), their labels and the map back to the input's frame.
+    /// The trained sites (trainable then boundary; unit-cube coordinates), their labels and
+    /// the map back to the input's frame.
     pub sites: SitesFile,
-    /// The checked crust in the input's frame (counter-clockwise seen from outside).
+    /// The crust in the input's frame (counter-clockwise seen from outside), rounded to
+    /// `FitConfig::output_precision` and checked exactly as rounded: write it as it is.
     pub crust: TriMesh,
     /// The training state at the end (sites, optimiser, losses).
     pub state: TrainState,
@@ -111,9 +112,9 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     timings.train = lap.next();
 
     progress.stage(Stage::Crust);
-    let (mut sites, labels, num_projected) = trainer.final_sites();
-    let checked = crust_of(&mut sites, &labels, s.seed)?;
-    let crust_mesh = checked.in_frame(&p.transform);
+    let (sites, labels, num_projected) = trainer.final_sites();
+    let checked = crust_of(&sites, &labels, &p.transform, config.output_precision)?;
+    let crust_mesh = checked.written.mesh.clone();
     timings.crust = lap.next();
 
     progress.stage(Stage::Evaluate);
@@ -234,12 +235,14 @@ fn misclassification(
 }
 
 fn crust_report(checked: &CheckedCrust, mesh: &TriMesh, num_projected: usize) -> CrustReport {
-    let r = &checked.check.report;
+    let r = &checked.check().report;
     CrustReport {
         num_sites: checked.crust.stats.num_sites,
         num_inside: checked.crust.stats.num_inside,
         num_sites_projected_into_cube: num_projected,
-        jitter_retries: checked.retries,
+        num_merged_vertices: checked.crust.stats.num_merged_vertices,
+        num_merged_in_output: checked.written.num_merged_vertices,
+        num_separated_in_output: checked.written.num_separated_vertices,
         num_vertices: mesh.positions.len(),
         num_triangles: mesh.triangles.len(),
         num_components: r.num_components,

@@ -83,12 +83,12 @@ fn fast_inside_matches_exact_near_minus_one_half() {
         let q = [0.9 * (2.0 * uniform() - 1.0), 0.9 * (2.0 * uniform() - 1.0), 0.3 + 0.7 * uniform()];
         let exact = oracle.winding_number(q, WindingMode::Exact, &mut ws);
         near_half += ((exact + 0.5).abs() < 0.01) as usize;
-        assert_eq!(
-            oracle.is_inside(q, WindingMode::Fast, &mut ws),
-            exact.abs() >= 0.5,
-            "at {q:?} (exact w {exact})"
-        );
+        assert_eq!(oracle.is_inside(q, WindingMode::Fast, &mut ws), exact.abs() >= 0.5, "at {q:?} (exact w {exact})");
     }
     assert!(near_half > 0, "no query near w = −0.5: the test does not exercise the fallback");
-    assert!(ws.num_exact_fallbacks >= near_half as u64, "{} fallbacks, {near_half} queries within 0.01 of −0.5", ws.num_exact_fallbacks);
+    assert!(
+        ws.num_exact_fallbacks >= near_half as u64,
+        "{} fallbacks, {near_half} queries within 0.01 of −0.5",
+        ws.num_exact_fallbacks
+    );
 }

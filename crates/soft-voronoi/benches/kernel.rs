@@ -2,9 +2,9 @@
 //! N = 65,536 samples, β = 10,000, sparse kernel.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use soft_voronoi::init::paper_init;
 use soft_voronoi::kernel::{Kernel, SiteIndex};
 use soft_voronoi::losses;
-use soft_voronoi::init::paper_init;
 
 fn bench(c: &mut Criterion) {
     let (sites, labels) = paper_init(4096, 1);

@@ -7,9 +7,9 @@
 
 use std::time::Instant;
 
+use soft_voronoi::init::paper_init;
 use soft_voronoi::kernel::{Kernel, SiteIndex};
 use soft_voronoi::losses;
-use soft_voronoi::init::paper_init;
 
 fn main() {
     let args: Vec<f64> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();

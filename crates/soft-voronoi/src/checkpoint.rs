@@ -12,7 +12,7 @@
 //! | `adam_m`, `adam_v` | (K, 3) float64 | Adam moments |
 //! | `graph_offsets`, `graph_neighbors` | uint32 | Delaunay graph at the last refresh (CSR) |
 //! | `located_inside`, `located_closest` | (K,) uint8, (K, 3) float64 | sides and closest surface points at the last refresh |
-//! | `history` | (steps, 9) float64 | per-step statistics ([`StepStats::NAMES`](crate::StepStats::NAMES)) |
+//! | `history` | (steps, 10) float64 (9 in checkpoints written before the surface term) | per-step statistics ([`StepStats::NAMES`](crate::StepStats::NAMES)) |
 //! | `data_fingerprint` | (1,) uint64 | fingerprint of the training samples |
 //!
 //! f64 values are stored bit for bit, so a resumed run repeats the uninterrupted one
@@ -42,7 +42,7 @@ pub fn write(path: &Path, state: &TrainState, context_json: &str) -> Result<(), 
     let config = serde_json::to_string(&state.config).map_err(|e| fail(e.to_string()))?;
     let closest: Vec<[f64; 3]> = state.located.iter().map(|l| l.closest).collect();
     let hist: Vec<f64> = state.history.iter().flat_map(|s| s.to_row()).collect();
-    let hist = Array2::from_shape_vec((state.history.len(), StepStats::COLUMNS), hist).expect("S×9");
+    let hist = Array2::from_shape_vec((state.history.len(), StepStats::COLUMNS), hist).expect("S×COLUMNS");
     let mut w = NpzOut::new();
     w.add_vec("format_version", vec![FORMAT_VERSION])
         .and_then(|w| w.add_vec("config_json", config.into_bytes()))
@@ -104,7 +104,7 @@ pub fn read(path: &Path) -> Result<(TrainState, String), TrainError> {
     let inside = arr1!("located_inside", u8);
     let closest = arr2!("located_closest");
     let hist: Array2<f64> = npz.by_name("history").map_err(|e| fail(format!("array 'history': {e}")))?;
-    if hist.ncols() != StepStats::COLUMNS {
+    if hist.ncols() != StepStats::COLUMNS && hist.ncols() != 9 {
         return Err(fail(format!("array 'history' has {} columns, expected {}", hist.ncols(), StepStats::COLUMNS)));
     }
     let history = hist.rows().into_iter().map(|r| StepStats::from_row(r.as_slice().unwrap_or(&r.to_vec()))).collect();

@@ -3,10 +3,10 @@
 
 use vf_common::rng::{ChunkRng, Stream};
 
+use crate::data::TrainingData;
 use crate::error::TrainError;
 use crate::kernel::SiteIndex;
 use crate::losses::Solid;
-use crate::data::TrainingData;
 
 /// Distance of the boundary sites from the faces of the unit cube (they must lie
 /// strictly inside it for the crust).
@@ -156,4 +156,236 @@ pub fn boundary_sites(count: usize) -> Vec<[f64; 3]> {
 /// Side m of the per-face grid for about `count` boundary sites (`None` for none).
 pub fn boundary_grid_size(count: usize) -> Option<usize> {
     (count > 0).then(|| ((count as f64 / 6.0).sqrt().ceil() as usize).max(1))
+}
+
+/// Well-spread mirrored pairs: about K/2 surface points chosen by greedy Poisson-disk
+/// sampling (a minimum distance r found by bisection so the count is K/2; candidates are
+/// the first 12·K of `data.surface`, already area-uniform and random), each giving the
+/// sites p ± δ·n with δ = `offset` × r. Where both sites of a pair land on the same side of
+/// the solid (a part thinner than 2δ, or a crease), δ is halved up to three times, so thin
+/// parts keep one site on each side. Labels come from the solid.
+///
+/// Returns the sites, their labels and r0 (the uniform spacing of the pairs away from thin
+/// parts, unit-cube lengths).
+///
+/// # Errors
+/// [`TrainError::Data`] when there are fewer than K/2 surface points.
+pub fn pairs_init(
+    k: usize,
+    data: &TrainingData,
+    solid: &dyn Solid,
+    offset: f64,
+    seed: u64,
+) -> Result<(Vec<[f64; 3]>, Vec<bool>, f64), TrainError> {
+    let pairs = k / 2;
+    let n = data.surface.len();
+    if n < pairs.max(2) || data.normals.len() != n {
+        return Err(TrainError::Data(format!("{n} surface samples (with normals) cannot seed {pairs} site pairs")));
+    }
+    let m = n.min(12 * k.max(1));
+    let candidates = &data.surface[..m];
+    // A uniform spacing first, then a cap on each candidate's spacing where the part is
+    // thinner (or the surface more folded) than the pairs would be wide there.
+    let (_, r0) = poisson_subset(candidates, pairs);
+    let cap = feature_caps(candidates, &data.normals[..m], solid, r0, offset);
+    let (chosen, spacing) = adaptive_subset(candidates, &cap, pairs);
+    let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 3);
+    let mut delta: Vec<f64> = spacing.iter().map(|&h| offset * h).collect();
+    let mut sites = vec![[0.0; 3]; 2 * chosen.len()];
+    let place = |sites: &mut [[f64; 3]], delta: &[f64], which: &[usize]| {
+        for &i in which {
+            let (p, nrm) = (data.surface[chosen[i] as usize], data.normals[chosen[i] as usize]);
+            sites[2 * i] = [0, 1, 2].map(|c| (p[c] + delta[i] * nrm[c]).clamp(1e-6, 1.0 - 1e-6));
+            sites[2 * i + 1] = [0, 1, 2].map(|c| (p[c] - delta[i] * nrm[c]).clamp(1e-6, 1.0 - 1e-6));
+        }
+    };
+    let all: Vec<usize> = (0..chosen.len()).collect();
+    place(&mut sites, &delta, &all);
+    let mut located = solid.locate(&sites);
+    // Each site must sit on its own side with p as (nearly) its closest surface point: a
+    // site that crossed a thin part, or came closer to another part of the surface than
+    // to p (δ beyond the local feature size), has its pair's δ halved, up to five times.
+    for _ in 0..5 {
+        let ok = |j: usize| {
+            let d = crate::kernel::distance(sites[j], located[j].closest);
+            d >= 0.7 * delta[j / 2]
+        };
+        let bad: Vec<usize> = (0..chosen.len())
+            .filter(|&i| located[2 * i].inside == located[2 * i + 1].inside || !ok(2 * i) || !ok(2 * i + 1))
+            .collect();
+        if bad.is_empty() {
+            break;
+        }
+        bad.iter().for_each(|&i| delta[i] *= 0.5);
+        place(&mut sites, &delta, &bad);
+        let moved: Vec<[f64; 3]> = bad.iter().flat_map(|&i| [sites[2 * i], sites[2 * i + 1]]).collect();
+        for (j, l) in solid.locate(&moved).into_iter().enumerate() {
+            located[2 * bad[j / 2] + j % 2] = l;
+        }
+    }
+    let labels: Vec<bool> = located.iter().map(|l| l.inside).collect();
+    // A pair whose sites still share a side (a crease, a hole, a part thinner than δ/8)
+    // would put a site of one label among the other's, which grows a spike of crust: keep
+    // one of its sites only.
+    let mut kept_sites = Vec::with_capacity(k);
+    let mut kept_labels = Vec::with_capacity(k);
+    for i in 0..chosen.len() {
+        let both = labels[2 * i] != labels[2 * i + 1];
+        for j in [2 * i, 2 * i + 1].into_iter().take(if both { 2 } else { 1 }) {
+            kept_sites.push(sites[j]);
+            kept_labels.push(labels[j]);
+        }
+    }
+    let (mut sites, mut labels) = (kept_sites, kept_labels);
+    while sites.len() < k {
+        // Odd K, too few well-spread points or dropped sites: training samples fill up,
+        // with their ground truth.
+        let i = (rng.next_u64() % data.points.len() as u64) as usize;
+        sites.push(data.points[i]);
+        labels.push(data.occupancy[i]);
+    }
+    Ok((sites, labels, r0))
+}
+
+/// Greedy Poisson-disk subset of `points` (in order) with `target` points: r is bisected
+/// (on a log scale, 20 rounds) for the largest r giving at least `target` points, and the
+/// first `target` accepted points are returned with r.
+fn poisson_subset(points: &[[f64; 3]], target: usize) -> (Vec<u32>, f64) {
+    let (mut lo, mut hi) = (1e-6f64, 1.0f64);
+    let mut best = (0..target.min(points.len()) as u32).collect::<Vec<_>>();
+    let mut best_r = 0.0;
+    for _ in 0..20 {
+        let r = (lo * hi).sqrt();
+        let got = greedy_disk(points, r);
+        if got.len() >= target {
+            lo = r;
+            best = got;
+            best_r = r;
+        } else {
+            hi = r;
+        }
+    }
+    best.truncate(target);
+    (best, best_r)
+}
+
+/// Points of `points`, in order, kept when no kept point lies within `r` (a uniform grid
+/// of cells of side ≥ r over the unit cube, 27 neighbouring cells checked).
+fn greedy_disk(points: &[[f64; 3]], r: f64) -> Vec<u32> {
+    // Cells of side 1/m ≥ r, so a conflict lies in a neighbouring cell.
+    let m = ((1.0 / r).floor() as usize).clamp(1, 256);
+    let cell = |p: [f64; 3]| p.map(|x| ((x * m as f64) as isize).clamp(0, m as isize - 1));
+    let mut head = vec![u32::MAX; m * m * m];
+    let mut next: Vec<u32> = Vec::new();
+    let mut kept: Vec<u32> = Vec::new();
+    let r2 = r * r;
+    for (i, &p) in points.iter().enumerate() {
+        let c = cell(p);
+        let mut free = true;
+        'search: for dx in -1..=1isize {
+            for dy in -1..=1isize {
+                for dz in -1..=1isize {
+                    let q = [c[0] + dx, c[1] + dy, c[2] + dz];
+                    if q.iter().any(|&x| x < 0 || x >= m as isize) {
+                        continue;
+                    }
+                    let mut j = head[(q[0] as usize * m + q[1] as usize) * m + q[2] as usize];
+                    while j != u32::MAX {
+                        let o = points[kept[j as usize] as usize];
+                        let d2 = (o[0] - p[0]).powi(2) + (o[1] - p[1]).powi(2) + (o[2] - p[2]).powi(2);
+                        if d2 < r2 {
+                            free = false;
+                            break 'search;
+                        }
+                        j = next[j as usize];
+                    }
+                }
+            }
+        }
+        if free {
+            let h = (c[0] as usize * m + c[1] as usize) * m + c[2] as usize;
+            next.push(head[h]);
+            head[h] = kept.len() as u32;
+            kept.push(i as u32);
+        }
+    }
+    kept
+}
+
+/// For each surface point p (normal n), the largest spacing h in r0, r0/2, …, r0/16 whose
+/// pair p ± offset·h·n has one site on each side of the solid and p (nearly) closest to
+/// both: infinity where r0 itself passes (no cap), else that h. Thin parts and tight folds
+/// get proportionally more, closer pairs, so they do not grow spikes.
+fn feature_caps(points: &[[f64; 3]], normals: &[[f64; 3]], solid: &dyn Solid, r0: f64, offset: f64) -> Vec<f64> {
+    let mut cap = vec![f64::INFINITY; points.len()];
+    let mut open: Vec<usize> = (0..points.len()).collect();
+    let mut h = r0;
+    for level in 0..5 {
+        if open.is_empty() {
+            break;
+        }
+        let delta = offset * h;
+        let probes: Vec<[f64; 3]> = open
+            .iter()
+            .flat_map(|&i| {
+                let (p, n) = (points[i], normals[i]);
+                [1.0, -1.0].map(|s| [0, 1, 2].map(|c| p[c] + s * delta * n[c]))
+            })
+            .collect();
+        let located = solid.locate(&probes);
+        let mut still = Vec::new();
+        for (j, &i) in open.iter().enumerate() {
+            let (a, b) = (&located[2 * j], &located[2 * j + 1]);
+            let good = a.inside != b.inside
+                && crate::kernel::distance(probes[2 * j], a.closest) >= 0.7 * delta
+                && crate::kernel::distance(probes[2 * j + 1], b.closest) >= 0.7 * delta;
+            if good {
+                if level > 0 {
+                    cap[i] = h;
+                }
+            } else {
+                still.push(i);
+            }
+        }
+        open = still;
+        h *= 0.5;
+    }
+    for i in open {
+        cap[i] = 2.0 * h;
+    }
+    cap
+}
+
+/// About `target` well-spread points of `points` with their spacing: where `cap` is finite
+/// (thin parts, folds, sharp creases) a Poisson-disk subset at that spacing, one pass per
+/// cap level; elsewhere a Poisson-disk subset at the uniform spacing that makes up the
+/// rest of the count. Thin regions take at most half the budget (their greedy order is
+/// random, so truncation thins them evenly).
+fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], target: usize) -> (Vec<u32>, Vec<f64>) {
+    let mut levels: Vec<f64> = cap.iter().copied().filter(|c| c.is_finite()).collect();
+    levels.sort_by(f64::total_cmp);
+    levels.dedup();
+    let mut chosen = Vec::new();
+    let mut spacing = Vec::new();
+    for &h in levels.iter().rev() {
+        let ids: Vec<u32> = (0..points.len() as u32).filter(|&i| cap[i as usize] == h).collect();
+        let pts: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+        for j in greedy_disk(&pts, h) {
+            chosen.push(ids[j as usize]);
+            spacing.push(h);
+        }
+    }
+    chosen.truncate(target / 2);
+    spacing.truncate(target / 2);
+    let ids: Vec<u32> = (0..points.len() as u32).filter(|&i| cap[i as usize].is_infinite()).collect();
+    let pts: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+    let rest = target - chosen.len();
+    if rest > 0 && !pts.is_empty() {
+        let (base, r) = poisson_subset(&pts, rest);
+        for j in base {
+            chosen.push(ids[j as usize]);
+            spacing.push(r);
+        }
+    }
+    (chosen, spacing)
 }

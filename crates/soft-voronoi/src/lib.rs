@@ -24,9 +24,9 @@ pub mod solid;
 pub mod train;
 
 pub use config::{Init, TrainConfig, Weights};
-pub use vf_common::AdamParams;
 pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};
 pub use solid::{MeshSolid, Sphere};
 pub use train::{classify, soft_values, StepStats, TrainState, Trainer, TrainingData};
+pub use vf_common::AdamParams;

@@ -4,12 +4,10 @@ use vf_common::rng::{ChunkRng, Stream};
 
 use crate::config::{Init, TrainConfig};
 pub use crate::data::TrainingData;
-use crate::init::{boundary_sites, paper_init, project_sites, samples_init, surface_init};
 use crate::error::TrainError;
+use crate::init::{boundary_sites, pairs_init, paper_init, project_sites, samples_init, surface_init};
 use crate::kernel::{self, Kernel, Scratch, SiteIndex};
 use crate::losses::{self, Located, SiteGraph, Solid};
-
-
 
 /// Losses and settings of one step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -32,17 +30,30 @@ pub struct StepStats {
     pub centroidal: f64,
     /// Largest coordinate move of the step.
     pub max_move: f64,
+    /// Surface term (mean squared distance of surface samples to their bisectors).
+    #[serde(default)]
+    pub surface: f64,
 }
 
 impl StepStats {
     /// Number of f64 fields in [`StepStats::to_row`].
-    pub const COLUMNS: usize = 9;
+    pub const COLUMNS: usize = 10;
     /// Column names of [`StepStats::to_row`].
-    pub const NAMES: [&'static str; 9] =
-        ["step", "lr", "beta", "total", "reconstruction", "bounds", "signed_distance", "centroidal", "max_move"];
+    pub const NAMES: [&'static str; 10] = [
+        "step",
+        "lr",
+        "beta",
+        "total",
+        "reconstruction",
+        "bounds",
+        "signed_distance",
+        "centroidal",
+        "max_move",
+        "surface",
+    ];
 
     /// The stats as one row of f64.
-    pub fn to_row(&self) -> [f64; 9] {
+    pub fn to_row(&self) -> [f64; 10] {
         [
             self.step as f64,
             self.lr,
@@ -53,10 +64,12 @@ impl StepStats {
             self.signed_distance,
             self.centroidal,
             self.max_move,
+            self.surface,
         ]
     }
 
-    /// The inverse of [`StepStats::to_row`].
+    /// The inverse of [`StepStats::to_row`] (a 9-column row, written before the surface
+    /// term existed, reads with surface 0).
     pub fn from_row(r: &[f64]) -> Self {
         StepStats {
             step: r[0] as usize,
@@ -68,6 +81,7 @@ impl StepStats {
             signed_distance: r[6],
             centroidal: r[7],
             max_move: r[8],
+            surface: r.get(9).copied().unwrap_or(0.0),
         }
     }
 }
@@ -105,6 +119,8 @@ pub struct Trainer<'a> {
     grad: Vec<[f64; 3]>,
     batch_points: Vec<[f64; 3]>,
     batch_occupancy: Vec<bool>,
+    surface_points: Vec<[f64; 3]>,
+    surface_normals: Vec<[f64; 3]>,
 }
 
 impl<'a> Trainer<'a> {
@@ -120,6 +136,10 @@ impl<'a> Trainer<'a> {
             Init::Paper => paper_init(k, config.seed),
             Init::Samples => samples_init(k, data, config.seed)?,
             Init::Surface => surface_init(k, data, solid, config.surface_offset, config.seed)?,
+            Init::Pairs => {
+                let (sites, labels, _) = pairs_init(k, data, solid, config.surface_offset, config.seed)?;
+                (sites, labels)
+            }
         };
         let boundary = boundary_sites(config.boundary_sites.unwrap_or_else(|| (k as f64).sqrt().ceil() as usize));
         debug_assert_eq!(boundary.len(), config.num_boundary());
@@ -185,6 +205,8 @@ impl<'a> Trainer<'a> {
             grad: vec![[0.0; 3]; k],
             batch_points: Vec::with_capacity(b),
             batch_occupancy: Vec::with_capacity(b),
+            surface_points: Vec::new(),
+            surface_normals: Vec::new(),
         }
     }
 
@@ -264,7 +286,31 @@ impl<'a> Trainer<'a> {
         } else {
             0.0
         };
-        let total = w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen;
+        let srf = if w.surface > 0.0 && !self.data.surface.is_empty() {
+            let mut rng = ChunkRng::for_chunk(cfg.seed, Stream::SurfaceBatch, t as u64);
+            let m = self.data.surface.len() as u64;
+            self.surface_points.clear();
+            self.surface_normals.clear();
+            for _ in 0..cfg.surface_batch {
+                let i = (rng.next_u64() % m) as usize;
+                self.surface_points.push(self.data.surface[i]);
+                self.surface_normals.push(self.data.normals.get(i).copied().unwrap_or([0.0; 3]));
+            }
+            let labelled = losses::LabelledIndex::new(&st.sites, &st.labels);
+            losses::surface(
+                &labelled,
+                &st.sites,
+                &self.surface_points,
+                &self.surface_normals,
+                w.normal,
+                w.surface,
+                &mut self.grad,
+            )
+        } else {
+            0.0
+        };
+        let total =
+            w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen + w.surface * srf;
         if !total.is_finite() || !self.grad.iter().flatten().all(|g| g.is_finite()) {
             return Err(TrainError::Diverged { step: t, what: format!("loss {total}") });
         }
@@ -284,6 +330,7 @@ impl<'a> Trainer<'a> {
             signed_distance: sdf,
             centroidal: cen,
             max_move,
+            surface: srf,
         };
         st.history.push(stats);
         st.step += 1;
@@ -297,7 +344,6 @@ impl<'a> Trainer<'a> {
         project_sites(&self.state.sites, &self.state.labels)
     }
 }
-
 
 /// Hard Voronoi occupancy (nearest site's label) of each point, in parallel.
 pub fn classify(sites: &[[f64; 3]], labels: &[bool], points: &[[f64; 3]]) -> Vec<bool> {

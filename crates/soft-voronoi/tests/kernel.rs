@@ -1,9 +1,9 @@
 //! The sparse soft-Voronoi kernel against the dense f64 reference, finite differences and
 //! extreme inputs.
 
-use vf_common::rng::{ChunkRng, Stream};
 use soft_voronoi::kernel::{self, Kernel, Scratch, SiteIndex};
 use soft_voronoi::{dense, losses};
+use vf_common::rng::{ChunkRng, Stream};
 
 const BETAS: [f64; 6] = [10.0, 100.0, 1_000.0, 10_000.0, 30_000.0, 100_000.0];
 

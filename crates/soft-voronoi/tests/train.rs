@@ -2,9 +2,9 @@
 //! thread-count independence, and that training on a sphere improves the fit and leaves a
 //! watertight crust.
 
-use vf_common::rng::{ChunkRng, Stream};
 use soft_voronoi::losses::{self, SiteGraph, Solid};
 use soft_voronoi::{checkpoint, classify, Init, Sphere, TrainConfig, TrainError, TrainState, Trainer, TrainingData};
+use vf_common::rng::{ChunkRng, Stream};
 
 const SPHERE: Sphere = Sphere { center: [0.5, 0.5, 0.5], radius: 0.35 };
 

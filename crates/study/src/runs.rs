@@ -41,7 +41,15 @@ pub struct Row {
 }
 
 impl Row {
-    fn new(method: &str, size: String, params: usize, m: Measured, train_seconds: f64, steps: usize, loss: f64) -> Self {
+    fn new(
+        method: &str,
+        size: String,
+        params: usize,
+        m: Measured,
+        train_seconds: f64,
+        steps: usize,
+        loss: f64,
+    ) -> Self {
         Row {
             method: method.into(),
             params,
@@ -73,7 +81,12 @@ impl StudyProgress for () {}
 ///
 /// # Errors
 /// [`StudyError`] naming the failing run, or an output that cannot be written.
-pub fn run(budget: &Budget, seed: u64, meshes_dir: &Path, progress: &mut dyn StudyProgress) -> Result<Vec<Row>, StudyError> {
+pub fn run(
+    budget: &Budget,
+    seed: u64,
+    meshes_dir: &Path,
+    progress: &mut dyn StudyProgress,
+) -> Result<Vec<Row>, StudyError> {
     let data = sphere_data(budget.samples, seed);
     let mut rows = Vec::with_capacity(budget.num_runs());
     for &k in &budget.voronoi_sites {
@@ -111,9 +124,11 @@ fn voronoi_run(data: &Data, k: usize, budget: &Budget, seed: u64) -> Result<(Row
         last = trainer.step().map_err(fail)?.reconstruction;
     }
     let train_seconds = t.elapsed().as_secs_f64();
-    let (mut sites, labels, _) = trainer.final_sites();
-    let checked = fit::crust_of(&mut sites, &labels, seed).map_err(|e| StudyError::Run(format!("K = {k}: {e}")))?;
-    let mesh = checked.crust.mesh;
+    let (sites, labels, _) = trainer.final_sites();
+    // The study's surfaces stay in the unit cube, written as GLB (float32).
+    let checked = fit::crust_of(&sites, &labels, crust::output::FrameMap::Identity, crust::output::Precision::F32)
+        .map_err(|e| StudyError::Run(format!("K = {k}: {e}")))?;
+    let mesh = checked.written.mesh;
     let m = measure(&mesh, budget.chamfer_samples, seed)?;
     Ok((Row::new("voronoi", format!("K={k}"), 3 * k, m, train_seconds, budget.voronoi_steps, last), mesh))
 }

@@ -85,13 +85,7 @@ fn write_table(out: &Path, rows: &[Row], budget: &Budget, seed: u64) -> Result<(
     md += &format!(
         "Sphere of radius 0.35 in the unit cube; budgets: Voronoi {} steps × 16,384 samples (default preset), MLPs {} \
          steps × {} samples (Adam, lr {} cosine to 1%), marching cubes at {}³; {} training samples; seed {}.\n\n",
-        budget.voronoi_steps,
-        budget.mlp_steps,
-        budget.mlp_batch,
-        budget.mlp_lr,
-        budget.mc_res,
-        budget.samples,
-        seed
+        budget.voronoi_steps, budget.mlp_steps, budget.mlp_batch, budget.mlp_lr, budget.mc_res, budget.samples, seed
     );
     md += "| method | size | parameters | Hausdorff [lo, hi] | Chamfer L1 | triangles | watertight | train s |\n";
     md += "|---|---|---|---|---|---|---|---|\n";

@@ -16,7 +16,6 @@ use rng::{ChunkRng, Stream};
 /// Points per sampling chunk (fixed: part of the definition of the sample sequence).
 pub const SAMPLE_CHUNK: usize = 4096;
 
-
 /// `n` points uniform in the box `[lo, hi]`.
 ///
 /// - `lo`, `hi`: box corners, f64, any frame (output in the same), `lo <= hi`.
