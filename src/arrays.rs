@@ -12,31 +12,25 @@ use ndarray_npy::{ReadNpyExt, WritableElement, WriteNpyExt};
 
 use crate::cli_error::CliError;
 
-fn bad(path: &Path, msg: impl std::fmt::Display) -> CliError {
-    CliError::input(format!("{}: {msg}", path.display()))
-}
-
 /// Read an (n, 3) array of points, f64 or f32, from a `.npy` file.
 ///
 /// # Errors
 /// Bad input naming the file for a missing file, a malformed header, another dtype or
 /// shape, or a NaN/infinite coordinate (naming the row).
 pub fn read_points_npy(path: &Path) -> Result<Vec<[f64; 3]>, CliError> {
-    let bytes = std::fs::read(path).map_err(|e| bad(path, format!("cannot read the file ({e}).")))?;
+    let bytes = std::fs::read(path).map_err(|e| CliError::input_in(path, format!("cannot read the file ({e}).")))?;
     let a: Array2<f64> = match Array2::<f64>::read_npy(Cursor::new(&bytes)) {
         Ok(a) => a,
         Err(e64) => match Array2::<f32>::read_npy(Cursor::new(&bytes)) {
             Ok(a) => a.mapv(f64::from),
             Err(_) => {
-                return Err(bad(
-                    path,
-                    format!("not a 2-D float64 or float32 .npy array ({e64}). Save it with numpy.save(path, points.astype(numpy.float64)) where points has shape (n, 3)."),
+                return Err(CliError::input_in(path, format!("not a 2-D float64 or float32 .npy array ({e64}). Save it with numpy.save(path, points.astype(numpy.float64)) where points has shape (n, 3)."),
                 ))
             }
         },
     };
     if a.ncols() != 3 {
-        return Err(bad(
+        return Err(CliError::input_in(
             path,
             format!("the array has shape ({}, {}); points must have shape (n, 3).", a.nrows(), a.ncols()),
         ));
@@ -45,7 +39,7 @@ pub fn read_points_npy(path: &Path) -> Result<Vec<[f64; 3]>, CliError> {
     for (i, row) in a.rows().into_iter().enumerate() {
         let p = [row[0], row[1], row[2]];
         if p.iter().any(|c| !c.is_finite()) {
-            return Err(bad(path, format!("row {i} is {p:?}, not finite. Remove or repair the point.")));
+            return Err(CliError::input_in(path, format!("row {i} is {p:?}, not finite. Remove or repair the point.")));
         }
         out.push(p);
     }

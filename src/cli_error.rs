@@ -34,6 +34,11 @@ impl CliError {
         CliError::BadInput(anyhow::anyhow!("{message}"))
     }
 
+    /// An error in the input file `path`, from a message (printed after the file's name).
+    pub fn input_in(path: &Path, message: impl fmt::Display) -> Self {
+        CliError::input(format!("{}: {message}", path.display()))
+    }
+
     /// An error that is not the input's fault, from a message.
     pub fn failure(message: impl fmt::Display) -> Self {
         CliError::Failure(anyhow::anyhow!("{message}"))

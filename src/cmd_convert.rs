@@ -3,7 +3,6 @@
 
 use std::path::PathBuf;
 
-use anyhow::anyhow;
 use mesh_io::OutputFormat;
 
 use crate::cli_error::CliError;
@@ -32,7 +31,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     // Everything about the output is checked before the input is read.
     let format = OutputFormat::from_path(&args.output)?;
     if !(0.0..0.5).contains(&args.margin) {
-        return Err(CliError::BadInput(anyhow!("--margin {} is outside [0, 0.5).", args.margin)));
+        return Err(CliError::input(format!("--margin {} is outside [0, 0.5).", args.margin)));
     }
     mesh_io::check_output_location(&args.output)?;
     let mut mesh = mesh_io::read_mesh(&args.mesh)?;
@@ -50,7 +49,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     }
     if args.normalize {
         let t = mesh_io::UnitCubeTransform::of_mesh(&mesh, args.margin).ok_or_else(|| {
-            CliError::BadInput(anyhow!(
+            CliError::input(format!(
                 "{}: all vertices coincide, so the mesh cannot be scaled into the unit cube.",
                 args.mesh.display()
             ))

@@ -7,12 +7,11 @@
 
 use std::path::PathBuf;
 
-use anyhow::anyhow;
-use crust::output::{finalize, Precision};
-use crust::{Crust, CrustConfig, CrustError, SitesFile};
-use mesh_io::{GltfLayout, SceneMesh, TriMesh};
+use crust::output::{finalize, FrameMap, Precision};
+use crust::{Crust, CrustConfig, SitesFile};
+use mesh_io::{GltfLayout, OutputFormat, SceneMesh, TriMesh};
 
-use crate::cli_error::CliError;
+use crate::cli_error::{CliError, InFile};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -30,50 +29,28 @@ pub struct Args {
     pub json: bool,
 }
 
-fn check_output_ext(path: &std::path::Path, allowed: &[&str]) -> Result<(), CliError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-    if !allowed.contains(&ext.as_str()) {
-        return Err(CliError::BadInput(anyhow!(
-            "{}: the output must end in {}",
-            path.display(),
-            allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
-        )));
-    }
-    Ok(())
-}
-
-/// Map a unit-cube mesh to the mesh frame; flip triangles if the map mirrors.
-fn to_mesh_frame(file: &SitesFile, mesh: &TriMesh) -> TriMesh {
-    let flip = file.transform_mirrors();
-    TriMesh {
-        positions: mesh.positions.iter().map(|&p| file.to_mesh_frame(p)).collect(),
-        triangles: mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect(),
-    }
-}
-
 pub fn run(args: Args) -> Result<(), CliError> {
-    check_output_ext(&args.output, &["glb", "gltf", "obj", "ply"])?;
+    OutputFormat::from_path(&args.output)?;
+    mesh_io::check_output_location(&args.output)?;
     if let Some(c) = &args.cells {
-        check_output_ext(c, &["glb", "gltf"])?;
+        OutputFormat::from_path_in(c, &[OutputFormat::Glb, OutputFormat::Gltf])?;
+        mesh_io::check_output_location(c)?;
     }
-    let file = SitesFile::read(&args.sites).map_err(|e| CliError::BadInput(e.into()))?;
-    let classify = |e: CrustError| match e {
-        CrustError::Internal(_) => CliError::Failure(anyhow!("{}: {e}; please report this", args.sites.display())),
-        e => CliError::BadInput(anyhow!("{}: {e}", args.sites.display())),
-    };
+    let file = SitesFile::read(&args.sites)?;
     // Extraction checks the crust in the unit cube; `finalize` checks it again exactly as
     // the file will hold it, before anything is written.
-    let mut crust = Crust::extract(&file.sites, &file.inside, &CrustConfig::default()).map_err(classify)?;
+    let mut crust = Crust::extract(&file.sites, &file.inside, &CrustConfig::default()).in_file(&args.sites)?;
     let precision = Precision::of_path(&args.output)?;
-    let written = finalize(&crust, file.transform, precision).map_err(classify)?;
+    let written = finalize(&crust, file.transform, precision).in_file(&args.sites)?;
     let (out, check) = (&written.mesh, &written.check);
     mesh_io::write_mesh(&args.output, out)?;
     let mut num_cells = 0;
     if let Some(path) = &args.cells {
-        let cells = crust.cells().map_err(|e| CliError::Failure(e.into()))?;
+        let cells = crust.cells().in_file(&args.sites)?;
+        let map = FrameMap::Matrix(file.transform);
         num_cells = cells.len();
         let meshes: Vec<(String, TriMesh)> =
-            cells.iter().map(|(i, m)| (format!("cell {i}"), to_mesh_frame(&file, m))).collect();
+            cells.iter().map(|(i, m)| (format!("cell {i}"), map.map_mesh(m))).collect();
         let scene: Vec<SceneMesh> = meshes.iter().map(|(name, mesh)| SceneMesh { name, mesh, colors: None }).collect();
         let layout = if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf")) {
             GltfLayout::Separate

@@ -156,8 +156,8 @@ def test_chamfer_and_iou_agree_with_independent_estimates(evaluated, name):
         lo = np.minimum(VA.min(0), VB.min(0))
         hi = np.maximum(VA.max(0), VB.max(0))
         q = lo + np.random.default_rng(5).random((100_000, 3)) * (hi - lo)
-        wa = igl.winding_number(VA, FA, q) >= 0.5
-        wb = igl.winding_number(VB, FB, q) >= 0.5
+        wa = np.abs(igl.winding_number(VA, FA, q)) >= 0.5  # the one inside rule, |w| >= 0.5
+        wb = np.abs(igl.winding_number(VB, FB, q)) >= 0.5
         iou = (wa & wb).sum() / max((wa | wb).sum(), 1)
         assert abs(r["iou"]["iou"] - iou) <= 0.01, (r["iou"], iou)
 

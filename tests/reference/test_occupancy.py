@@ -95,9 +95,11 @@ def test_fast_winding_within_1e_3_and_never_flips(case):
     w_igl = igl.winding_number(V, F, Q)
     err = np.abs(fast["winding"] - w_igl)
     assert err.max() <= 1e-3, f"{name}: max |fast - igl exact| = {err.max():.3e}"
-    flips = np.count_nonzero((fast["winding"] >= 0.5) != (w_igl >= 0.5))
+    # The one inside rule: |w| >= 0.5 (inward-facing bodies are solid too); the fast path
+    # falls back to the exact value near both +0.5 and -0.5, so it never flips.
+    flips = np.count_nonzero((np.abs(fast["winding"]) >= 0.5) != (np.abs(w_igl) >= 0.5))
     assert flips == 0, f"{name}: {flips} inside/outside flips"
-    assert np.array_equal(fast["occupancy"], (fast["winding"] >= 0.5).astype(np.uint8))
+    assert np.array_equal(fast["occupancy"], (np.abs(fast["winding"]) >= 0.5).astype(np.uint8))
 
 
 def test_squared_distances_equal_igl(case):
@@ -113,7 +115,7 @@ def test_squared_distances_equal_igl(case):
     # Signed distances: magnitude from the distance, sign from the winding number.
     sdf = fast["sdf"]
     assert np.array_equal(np.abs(sdf), np.sqrt(fast["squared_distance"]))
-    inside = fast["winding"] >= 0.5
+    inside = np.abs(fast["winding"]) >= 0.5
     assert np.all(sdf[inside] <= 0) and np.all(sdf[~inside] >= 0)
 
 
@@ -135,7 +137,7 @@ def test_sample_writes_documented_arrays_deterministically(tmp_path):
     # The labels are right: recompute with libigl on the sampled points.
     V, F = load("mikedh__teapot.stl")
     w = igl.winding_number(V, F, da["points"])
-    assert np.array_equal(da["occupancy"], (w >= 0.5).astype(np.uint8))
+    assert np.array_equal(da["occupancy"], (np.abs(w) >= 0.5).astype(np.uint8))
     sqrd, _, _ = igl.point_mesh_squared_distance(da["points"], V, F)
     assert np.allclose(np.abs(da["sdf"]), np.sqrt(sqrd), rtol=1e-12, atol=0)
     # 30% uniform in the grown box, the rest near the surface.

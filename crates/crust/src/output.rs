@@ -125,6 +125,19 @@ impl FrameMap {
         }
     }
 
+    /// `mesh` mapped by this map, every triangle reversed when the map mirrors (so outward
+    /// stays outward), without rounding or checks: for outputs that are not crusts (the
+    /// convex cells). The one place the workspace maps a unit-cube mesh to a frame by a
+    /// general matrix; [`mesh_io::UnitCubeTransform::mesh_from_unit`] is the same for the
+    /// normalisation's transform.
+    pub fn map_mesh(&self, mesh: &TriMesh) -> TriMesh {
+        let flip = self.mirrors();
+        TriMesh {
+            positions: mesh.positions.iter().map(|&p| self.apply(p)).collect(),
+            triangles: mesh.triangles.iter().map(|t| if flip { [t[0], t[2], t[1]] } else { *t }).collect(),
+        }
+    }
+
     fn check(&self) -> Result<(), CrustError> {
         let bad = match self {
             FrameMap::Identity => false,
