@@ -8,6 +8,7 @@
 //! [`weld::weld_tolerance`], [`weld::count_near_pairs`]. See the crate's README.md.
 
 pub mod atomic;
+mod dsu;
 pub mod error;
 pub mod limits;
 pub mod normalize;

@@ -4,6 +4,7 @@
 //! consistency, Euler number, body count, volume), so the reference checks can compare
 //! them one for one.
 
+use crate::dsu::Dsu;
 use serde::Serialize;
 
 use crate::TriMesh;
@@ -57,29 +58,6 @@ pub struct TopologyReport {
     /// Bounding box of the referenced vertices.
     pub bbox_min: [f64; 3],
     pub bbox_max: [f64; 3],
-}
-
-/// Union-find with path halving.
-struct Dsu(Vec<u32>);
-
-impl Dsu {
-    fn new(n: usize) -> Self {
-        Dsu((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[self.0[x as usize] as usize];
-            self.0[x as usize] = p;
-            x = p;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (a, b) = (self.find(a), self.find(b));
-        if a != b {
-            self.0[a.max(b) as usize] = a.min(b);
-        }
-    }
 }
 
 /// Exact collinearity of three points: all three coordinate-plane projections have zero

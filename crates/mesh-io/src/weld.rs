@@ -13,6 +13,7 @@
 //! apart): the same value means the same thing for a part in millimetres and in metres,
 //! and it compares directly with float32 rounding (about 6e-8 relative).
 
+use crate::dsu::Dsu;
 use std::collections::HashMap;
 
 use serde::Serialize;
@@ -241,29 +242,6 @@ fn for_each_near_pair(points: &[[f64; 3]], h: f64, mut f: impl FnMut(u32, u32) -
                     }
                 }
             }
-        }
-    }
-}
-
-/// Union-find with path halving; the root of a class is its lowest member.
-struct Dsu(Vec<u32>);
-
-impl Dsu {
-    fn new(n: usize) -> Self {
-        Dsu((0..n as u32).collect())
-    }
-    fn find(&mut self, mut x: u32) -> u32 {
-        while self.0[x as usize] != x {
-            let p = self.0[self.0[x as usize] as usize];
-            self.0[x as usize] = p;
-            x = p;
-        }
-        x
-    }
-    fn union(&mut self, a: u32, b: u32) {
-        let (a, b) = (self.find(a), self.find(b));
-        if a != b {
-            self.0[a.max(b) as usize] = a.min(b);
         }
     }
 }

@@ -47,18 +47,24 @@ pub fn reconstruction(
             (loss, contributions)
         })
         .collect();
+    reduce(parts, weight / n, grad) / n
+}
+
+/// Per-chunk partial losses and gradient contributions, summed in chunk order (so the
+/// result does not depend on the thread count); the contributions times `factor` are
+/// added into `grad`. Returns the summed loss.
+fn reduce(parts: Vec<(f64, Vec<(u32, [f64; 3])>)>, factor: f64, grad: &mut [[f64; 3]]) -> f64 {
     let mut loss = 0.0;
-    let f = weight / n;
     for (l, contributions) in parts {
         loss += l;
         for (k, g) in contributions {
             let acc = &mut grad[k as usize];
-            acc[0] += f * g[0];
-            acc[1] += f * g[1];
-            acc[2] += f * g[2];
+            acc[0] += factor * g[0];
+            acc[1] += factor * g[1];
+            acc[2] += factor * g[2];
         }
     }
-    loss / n
+    loss
 }
 
 /// Bounds loss Σ_k Σ_c max(−p_kc, 0) + max(p_kc − 1, 0) over the trainable sites (the
@@ -336,16 +342,5 @@ pub fn surface(
             (loss, contributions)
         })
         .collect();
-    let mut loss = 0.0;
-    let f = weight / m;
-    for (l, contributions) in parts {
-        loss += l;
-        for (k, g) in contributions {
-            let acc = &mut grad[k as usize];
-            acc[0] += f * g[0];
-            acc[1] += f * g[1];
-            acc[2] += f * g[2];
-        }
-    }
-    loss / m
+    reduce(parts, weight / m, grad) / m
 }
