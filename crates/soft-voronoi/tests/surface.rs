@@ -47,9 +47,25 @@ fn a_mirrored_pair_with_its_point_on_the_bisector_costs_nothing() {
     let sites = [[0.5, 0.5, 0.4], [0.5, 0.5, 0.6]];
     let labels = [true, false];
     let mut grad = vec![[0.0; 3]; 2];
-    let l = surface(&LabelledIndex::new(&sites, &labels), &sites, &[[0.52, 0.49, 0.5]], &[[0.0, 0.0, 1.0]], 1.0, 1.0, &mut grad);
+    let l = surface(
+        &LabelledIndex::new(&sites, &labels),
+        &sites,
+        &[[0.52, 0.49, 0.5]],
+        &[[0.0, 0.0, 1.0]],
+        1.0,
+        1.0,
+        &mut grad,
+    );
     assert!(l.abs() < 1e-15 && grad.iter().flatten().all(|g| g.abs() < 1e-12), "{l} {grad:?}");
     // Off the bisector by 0.01: d² = 1e-4.
-    let l = surface(&LabelledIndex::new(&sites, &labels), &sites, &[[0.5, 0.5, 0.51]], &[[0.0, 0.0, 1.0]], 0.0, 1.0, &mut grad);
+    let l = surface(
+        &LabelledIndex::new(&sites, &labels),
+        &sites,
+        &[[0.5, 0.5, 0.51]],
+        &[[0.0, 0.0, 1.0]],
+        0.0,
+        1.0,
+        &mut grad,
+    );
     assert!((l - 1e-4).abs() < 1e-15, "{l}");
 }
