@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use fit::{Checkpointing, FitConfig, FitError, Progress, DEFAULT_SITES};
+use fit::{Checkpointing, FitConfig, FitError, Progress, SolidRule, DEFAULT_SITES};
 use mesh_io::OutputFormat;
 use soft_voronoi::{Init, StepStats, TrainConfig};
 
@@ -91,6 +91,9 @@ pub struct Args {
     /// Keep OUT.ckpt.npz after a finished run.
     #[arg(long)]
     pub keep_checkpoint: bool,
+    /// Also write OUT.html, the offline viewer page of the result (as `voronoi-fit view`).
+    #[arg(long)]
+    pub html: bool,
     /// Print the report as JSON on stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
@@ -101,6 +104,60 @@ pub struct Args {
     /// (closes float-rounding cracks of CAD exports; e.g. 1e-6). Default: exact welding only.
     #[arg(long, value_parser = mesh_io::weld::parse_tolerance)]
     pub weld_tolerance: Option<f64>,
+    /// The solid to fit: `winding` (|winding number| ≥ 0.5: closed meshes, soups, open meshes
+    /// with a volume), `shell` (the surface thickened by a thin band: sheets, lone open
+    /// patches) or `auto` (winding, unless the mesh is open and its winding number stays
+    /// near ±0.5 beside most of the surface: a sheet).
+    #[arg(long, default_value = "auto", value_parser = parse_solid)]
+    pub solid: SolidRule,
+    /// Thickness of the shell solid as a fraction of the bounding-box diagonal (e.g. 0.01).
+    /// Default: about one site spacing.
+    #[arg(long)]
+    pub shell_thickness: Option<f64>,
+    /// Ask for an accuracy instead of a K: the certified Hausdorff distance to the input as
+    /// a share of its bounding-box diagonal (`0.5%` or `0.005`). The fit starts at --sites
+    /// and doubles K, refining where the error was, until met or --max-sites.
+    #[arg(long, value_parser = parse_share)]
+    pub target_hausdorff: Option<f64>,
+    /// Keep the training labels (default: after training every site takes the solid's label
+    /// where it stands).
+    #[arg(long)]
+    pub no_relabel: bool,
+    /// Insert mirrored pairs of sites where the crust strays farther than this share of the
+    /// diagonal from the input (`0.3%` or `0.003`), up to K/16 sites in four rounds, keeping
+    /// the best round. Default 0.3% (off with --preset paper).
+    #[arg(long, value_parser = parse_share)]
+    pub carve: Option<f64>,
+    /// No site insertion after training.
+    #[arg(long, conflicts_with = "carve")]
+    pub no_carve: bool,
+    /// Budget of sites for --target-hausdorff.
+    #[arg(long, default_value_t = 131_072)]
+    pub max_sites: usize,
+}
+
+/// `0.5%` → 0.005; `0.005` → 0.005.
+fn parse_share(s: &str) -> Result<f64, String> {
+    let (number, scale) = match s.strip_suffix('%') {
+        Some(n) => (n, 0.01),
+        None => (s, 1.0),
+    };
+    let x: f64 = number.trim().parse().map_err(|_| format!("`{s}` is not a share; write e.g. 0.5% or 0.005"))?;
+    let x = x * scale;
+    if x.is_finite() && x > 0.0 && x < 1.0 {
+        Ok(x)
+    } else {
+        Err(format!("`{s}` must be between 0 and 100% of the diagonal"))
+    }
+}
+
+fn parse_solid(s: &str) -> Result<SolidRule, String> {
+    match s {
+        "auto" => Ok(SolidRule::Auto),
+        "winding" => Ok(SolidRule::Winding),
+        "shell" => Ok(SolidRule::Shell),
+        _ => Err(format!("`{s}` is not a solid; use auto, winding or shell")),
+    }
 }
 
 /// Paths of the outputs.
@@ -132,6 +189,13 @@ fn outputs(args: &Args) -> Result<Outputs, CliError> {
 fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
     let mut c = FitConfig::new(&args.mesh.display().to_string(), args.sites.unwrap_or(DEFAULT_SITES));
     c.sampling.samples = args.samples;
+    c.sampling.solid = args.solid;
+    c.sampling.shell_thickness = args.shell_thickness;
+    c.train_shell = args.steps.is_some();
+    // The paper preset is the paper's method: no relabelling, no insertion.
+    let paper = args.preset == "paper";
+    c.relabel = !args.no_relabel && !paper;
+    c.carve = if args.no_carve || (paper && args.carve.is_none()) { None } else { args.carve.or(c.carve) };
     c.eval.samples = args.eval_samples;
     c.checkpointing = Some(Checkpointing { path: out.checkpoint.clone(), every: args.checkpoint_every });
     c.preset = args.preset.clone();
@@ -222,7 +286,14 @@ pub fn run(args: Args) -> Result<(), CliError> {
             .map_err(anyhow::Error::from)?,
     );
     let mut progress = CliProgress { bar, interrupted, stop_after: args.stop_after, done_here: 0 };
-    let result = match fit::fit(&input, &config, &mut progress) {
+    let result = match args.target_hausdorff {
+        Some(h) => {
+            let goal = fit::AccuracyGoal { hausdorff_of_diagonal: h, max_sites: args.max_sites };
+            fit::fit_to_accuracy(&input, &config, &goal, &mut progress)
+        }
+        None => fit::fit(&input, &config, &mut progress),
+    };
+    let result = match result {
         Err(FitError::Interrupted { step, steps, checkpoint }) => {
             return Err(CliError::Interrupted(format!(
                 "stopped at step {step} of {steps}; checkpoint {}. Continue with: voronoi-fit {} -o {} --resume {}",
@@ -241,6 +312,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
 fn write_outputs(out: &Outputs, mut result: fit::FitOutput, args: &Args, t_all: Instant) -> Result<(), CliError> {
     result.sites.write(&out.sites)?;
     mesh_io::write_mesh(&out.mesh, &result.crust)?;
+    // OUT.png: input and crust side by side from three views (the input is read again, as
+    // only the result reaches this function; reading is cheap next to the fit).
+    let picture = crate::cmd_view::picture_path(&out.mesh);
+    crate::cmd_view::write_picture(&picture, &read_input(args)?, &result.crust, &args.mesh, &result.report)?;
     let report = &mut result.report;
     report.outputs = fit::report::OutputsReport {
         crust: out.mesh.display().to_string(),
@@ -253,17 +328,27 @@ fn write_outputs(out: &Outputs, mut result: fit::FitOutput, args: &Args, t_all: 
     if !args.keep_checkpoint && out.checkpoint.exists() {
         let _ = std::fs::remove_file(&out.checkpoint);
     }
+    // --html: the viewer page, from the files just written.
+    let page = if args.html {
+        Some(crate::cmd_view::write_fit_page(&out.mesh, &args.mesh, &out.report, &out.sites)?)
+    } else {
+        None
+    };
     if args.json {
         crate::output::out!("{text}");
     } else {
         crate::output::out!(
-            "{} Wrote {}, {} and {} in {:.1} s.",
+            "{} Wrote {}, {}, {} and {} in {:.1} s.",
             report.summary(),
             out.mesh.display(),
             out.sites.display(),
+            picture.display(),
             out.report.display(),
             report.total_seconds
         );
+        if let Some(page) = &page {
+            crate::output::out!("Wrote the viewer page {} (open it in a browser; it works offline).", page.display());
+        }
     }
     Ok(())
 }

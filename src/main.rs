@@ -14,6 +14,7 @@ mod cmd_info;
 mod cmd_query;
 mod cmd_sample;
 mod cmd_study;
+mod cmd_view;
 mod output;
 
 use clap::{Parser, Subcommand};
@@ -61,6 +62,9 @@ enum Command {
     /// Reconstruction metrics of a predicted mesh against a reference: certified and
     /// libigl-compatible Hausdorff, Chamfer, F-score, normal consistency, IoU, validity.
     Eval(cmd_eval::Args),
+    /// One self-contained HTML page (works offline) showing the input and the crust, the
+    /// sites, misclassified points, cells, the loss curve and the stage timings.
+    View(cmd_view::Args),
 }
 
 fn main() {
@@ -90,6 +94,7 @@ fn main() {
         Command::Delaunay(args) => cmd_delaunay::run(args),
         Command::Crust(args) => cmd_crust::run(args),
         Command::Eval(args) => cmd_eval::run(args),
+        Command::View(args) => cmd_view::run(args),
     };
     if let Err(e) = result {
         match &e {

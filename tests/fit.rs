@@ -139,7 +139,12 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
     std::fs::write(&flat, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
     let nan = root().join("tests/malformed/nan_vertex.obj");
     let cases: Vec<(Vec<std::ffi::OsString>, &str)> = vec![
-        (vec![flat.clone().into()], "encloses no volume"),
+        (vec![flat.clone().into(), "--solid".into(), "winding".into()], "encloses no volume"),
+        (
+            vec![root().join("assets/bunny.obj").into(), "--target-hausdorff".into(), "200%".into()],
+            "between 0 and 100%",
+        ),
+        (vec![root().join("assets/bunny.obj").into(), "--solid".into(), "hollow".into()], "auto, winding or shell"),
         (vec!["/no/such/mesh.obj".into()], "/no/such/mesh.obj"),
         (vec![root().join("assets/bunny.obj").into(), "--sites".into(), "1".into()], "sites"),
         (vec![root().join("assets/bunny.obj").into(), "--lr".into(), "nan".into()], "learning rate"),
@@ -168,6 +173,26 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
         assert_eq!(std::fs::read_dir(out_dir.path()).unwrap().count(), 0, "{args:?}: wrote something");
     }
+}
+
+/// A lone triangle (no volume at all) fits a thin shell instead of being refused: a closed
+/// slab, said in the report and the summary.
+#[test]
+fn a_lone_triangle_fits_a_thin_shell() {
+    let dir = tempfile::tempdir().unwrap();
+    let flat = dir.path().join("flat.obj");
+    std::fs::write(&flat, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let out = dir.path().join("flat.glb");
+    let o = bin().arg(&flat).arg("-o").arg(&out).args(QUICK).output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("thin shell"), "{stdout}");
+    let r = report(&out);
+    assert_eq!(r["solid"]["rule"], "shell");
+    assert_eq!(r["crust"]["is_closed"], true);
+    assert_eq!(r["crust"]["num_components"], 1);
+    assert!(r["solid"]["half_thickness"].as_f64().unwrap() > 0.0);
+    keep_for_validator(&out, "lone_triangle_shell");
 }
 
 /// A real Ctrl-C (SIGINT) during training: exit 130, a readable checkpoint, no crust.

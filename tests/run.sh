@@ -4,7 +4,9 @@
 #
 #   1. a Python venv under target/venv with the pinned reference libraries
 #      (tests/requirements.txt: libigl, trimesh, numpy, scipy, pytest);
-#   2. the Khronos glTF validator (npm gltf-validator) under target/node;
+#   2. the Khronos glTF validator (npm gltf-validator) and playwright-core under
+#      target/node, and Debian's chromium + chromium-driver (apt-get, when absent) for the
+#      viewer page test;
 #   3. cargo test --workspace in the `ci` profile (release speed with debug assertions);
 #   4. the Python reference checks in tests/reference against the built binary.
 #
@@ -36,11 +38,26 @@ fi
 
 note "glTF validator ($TARGET/node)"
 NODE_DIR=$TARGET/node
-if [ ! -f "$NODE_DIR/node_modules/gltf-validator/package.json" ] || ! cmp -s tests/package.json "$NODE_DIR/package.json"; then
+if [ ! -f "$NODE_DIR/node_modules/gltf-validator/package.json" ] || [ ! -f "$NODE_DIR/node_modules/playwright-core/package.json" ] || ! cmp -s tests/package.json "$NODE_DIR/package.json"; then
   mkdir -p "$NODE_DIR"
   cp tests/package.json "$NODE_DIR/package.json"
   (cd "$NODE_DIR" && npm install --no-audit --no-fund --loglevel=error) || step_failed+=("npm install")
 fi
+
+note "Chromium for the viewer page test (tests/browser, tests/reference/test_view.py)"
+# Debian's chromium and chromium-driver; installed here when absent. If that fails, the
+# step fails (and so does the browser test): nothing is skipped silently.
+if [ ! -x /usr/bin/chromium ] || [ ! -x /usr/bin/chromedriver ]; then
+  if [ "$(id -u)" -eq 0 ]; then as_root=(); else as_root=(sudo -n); fi
+  if "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update -q > "$LOG/apt-chromium.log" 2>&1 \
+     && "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium chromium-driver >> "$LOG/apt-chromium.log" 2>&1; then
+    echo "installed: $(/usr/bin/chromium --version 2>/dev/null)"
+  else
+    echo "apt-get could not install chromium and chromium-driver (log: $LOG/apt-chromium.log)"
+    step_failed+=("install chromium")
+  fi
+fi
+[ -x /usr/bin/chromium ] || step_failed+=("chromium missing")
 
 note "cargo test --workspace --profile ci"
 # GLB/glTF files written by the Rust tests land here for the validator (pytest, below).

@@ -2,7 +2,7 @@
 
 use mesh_io::TriMesh;
 use occupancy::sample::{near_surface, uniform_in_box, SurfaceSampler};
-use soft_voronoi::{MeshSolid, TrainingData};
+use soft_voronoi::{Solid, TrainingData};
 
 use crate::error::FitError;
 
@@ -39,7 +39,7 @@ pub fn compact(mesh: &TriMesh) -> TriMesh {
 /// [`FitError::Failure`] from the samplers (invalid sizes).
 pub fn labelled_samples(
     sampler: &SurfaceSampler,
-    solid: &MeshSolid,
+    solid: &dyn Solid,
     n: usize,
     sigmas: &[f64],
     seed: u64,

@@ -5,7 +5,8 @@
 //!
 //! Stages (each timed in the report): drop unreferenced vertices and normalise into the
 //! unit cube ([`data`]); build the occupancy oracle; sample and label the training pool by
-//! the workspace's one inside rule ([`occupancy::Config::is_inside_winding`]); train the
+//! the workspace's one inside rule ([`occupancy::Config::is_inside_winding`]), or around a
+//! thin shell when the mesh encloses no volume ([`target`]); train the
 //! sites with the soft-Voronoi ([`soft_voronoi::Trainer`]), checkpointing as asked; extract
 //! and check the crust, map it back and round it as the output stores it, checked again
 //! ([`crust_of`]); measure the
@@ -20,17 +21,21 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+pub mod carve;
 pub mod config;
 pub mod crust_step;
 pub mod data;
 pub mod error;
+pub mod grow;
 pub mod progress;
 pub mod report;
 mod run;
+pub mod target;
 
-pub use config::{Checkpointing, EvalSampling, FitConfig, Sampling, DEFAULT_SITES, MARGIN};
+pub use config::{Checkpointing, EvalSampling, FitConfig, Sampling, SolidRule, DEFAULT_CARVE, DEFAULT_SITES, MARGIN};
 pub use crust_step::{crust_of, CheckedCrust};
 pub use error::FitError;
+pub use grow::{fit_to_accuracy, AccuracyGoal};
 pub use progress::{NoProgress, Progress, Stage};
 pub use report::FitReport;
 pub use run::{fit, FitOutput};

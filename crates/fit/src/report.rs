@@ -3,6 +3,8 @@
 use serde::Serialize;
 use soft_voronoi::{StepStats, TrainConfig, TrainState};
 
+pub use crate::target::SolidReport;
+
 /// The input as read.
 #[derive(Clone, Debug, Serialize)]
 pub struct InputReport {
@@ -43,13 +45,13 @@ pub struct SettingsReport {
     pub threads: usize,
 }
 
-/// The map from the unit cube back to the input: x = center + (u − 0.5)·scale… as
+/// The map from the input to the unit cube: u = (x − center)·scale + 0.5, as
 /// [`mesh_io::UnitCubeTransform`].
 #[derive(Clone, Debug, Serialize)]
 pub struct TransformReport {
     /// Centre of the input's bounding box.
     pub center: [f64; 3],
-    /// Scale (input units per unit-cube length).
+    /// Scale (unit-cube lengths per input length, as [`mesh_io::UnitCubeTransform`]).
     pub scale: f64,
 }
 
@@ -190,6 +192,9 @@ pub struct FitReport {
     pub input: InputReport,
     /// The settings.
     pub settings: SettingsReport,
+    /// The solid fitted: the winding-number solid, or a thin shell around a surface without
+    /// volume.
+    pub solid: SolidReport,
     /// Unit cube → input frame.
     pub transform: TransformReport,
     /// Stage timings.
@@ -202,6 +207,16 @@ pub struct FitReport {
     pub metrics: MetricsReport,
     /// The crust.
     pub crust: CrustReport,
+    /// Share of the pairs' candidate points refined from a previous fit (accuracy target
+    /// rounds after the first), else absent.
+    pub refined_share: Option<f64>,
+    /// Trainable sites whose label was changed to the solid's at their final position
+    /// (absent when relabelling was off).
+    pub relabelled_sites: Option<usize>,
+    /// Sites inserted where the crust strayed from the input (absent when off).
+    pub carving: Option<crate::carve::CarveReport>,
+    /// The accuracy target's goal and error-against-K trace, when one was asked for.
+    pub accuracy_target: Option<crate::grow::AccuracyReport>,
     /// Files written (empty until a writer fills them in).
     pub outputs: OutputsReport,
     /// Wall time of the fit, seconds.
@@ -229,24 +244,68 @@ impl FitReport {
             MetricsReport::Skipped { .. } => String::new(),
         };
         let inside_trainable = c.num_inside;
+        let inserted: usize = self.carving.as_ref().map_or(0, |r| r.inserted_per_round.iter().sum());
+        let carved = match &self.carving {
+            Some(r) if inserted > 0 => format!(
+                " Then {inserted} sites were inserted in {} round(s) where the crust strayed more than {:.2}% of the \
+                 diagonal from the input (farthest crust vertex {:.3}% → {:.3}%).",
+                r.inserted_per_round.len(),
+                100.0 * r.tolerance_of_diagonal,
+                100.0 * r.farthest_before / (r.tolerance / r.tolerance_of_diagonal),
+                100.0 * r.farthest_after / (r.tolerance / r.tolerance_of_diagonal)
+            ),
+            _ => String::new(),
+        };
+        let shell = match (self.solid.half_thickness, self.solid.half_thickness_of_diagonal) {
+            (Some(h), Some(f)) => format!(
+                " The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
+                 and 0.75 in magnitude), so the sites fit a thin shell: the surface thickened by {:.4e} on each side ({:.2}% of the diagonal); the \
+                 crust is that shell's boundary.",
+                100.0 * self.solid.near_surface_ambiguous_share,
+                h,
+                100.0 * f
+            ),
+            _ => String::new(),
+        };
+        let target = match &self.accuracy_target {
+            Some(a) => {
+                let steps: Vec<String> = a
+                    .trace
+                    .iter()
+                    .map(|r| format!("{} sites: {:.3}%", r.sites, 100.0 * r.hausdorff_hi_of_diagonal))
+                    .collect();
+                format!(
+                    " Accuracy target: Hausdorff ≤ {:.3}% of the diagonal {} with {} sites (budget {}; {}).",
+                    100.0 * a.goal_hausdorff_of_diagonal,
+                    if a.met { "met" } else { "NOT met" },
+                    a.sites_used,
+                    a.max_sites,
+                    steps.join(", ")
+                )
+            }
+            None => String::new(),
+        };
         format!(
             "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps; on {} fresh samples {:.3}% are \
-             misclassified ({:.3}% of uniform, {:.3}% of near-surface ones). Crust: {} triangles, {} component(s), \
-             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}. {}",
+             misclassified ({:.3}% of uniform, {:.3}% of near-surface ones).{} Crust: {} triangles, {} component(s), \
+             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{} {}{}",
             self.input.path,
             t.num_sites,
             inside_trainable,
-            c.num_sites - t.num_sites,
+            c.num_sites - t.num_sites - inserted,
             t.steps,
             self.settings.eval_samples,
             100.0 * q.misclassification,
             100.0 * q.misclassification_uniform,
             100.0 * q.misclassification_near_surface,
+            carved,
             c.num_triangles,
             c.num_components,
             c.genus.map_or("n/a".to_string(), |g| g.to_string()),
             c.volume,
-            metrics
+            shell,
+            metrics,
+            target
         )
     }
 }

@@ -6,7 +6,7 @@ use crust::SitesFile;
 use mesh_io::{TopologyReport, TriMesh, UnitCubeTransform};
 use occupancy::sample::SurfaceSampler;
 use occupancy::MeshOracle;
-use soft_voronoi::{checkpoint, classify, MeshSolid, TrainState, Trainer, TrainingData};
+use soft_voronoi::{checkpoint, classify, MeshSolid, Solid, TrainState, Trainer, TrainingData};
 
 use crate::config::FitConfig;
 use crate::crust_step::{crust_of, CheckedCrust};
@@ -14,6 +14,7 @@ use crate::data::{compact, labelled_samples};
 use crate::error::FitError;
 use crate::progress::{Progress, Stage};
 use crate::report::*;
+use crate::target;
 
 /// What a fit produces.
 pub struct FitOutput {
@@ -91,34 +92,73 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         .map_err(|e| FitError::Input(format!("{name}: {e}")))?;
     let sampler = SurfaceSampler::from_mesh(&p.unit)
         .map_err(|e| FitError::Input(format!("{name}: {e} (the mesh has no area to sample)")))?;
-    let solid = MeshSolid { oracle: &oracle };
+    let winding = MeshSolid { oracle: &oracle };
     timings.oracle = lap.next();
 
     progress.stage(Stage::Sample);
     let diagonal = p.unit.diagonal();
     let s = &config.sampling;
     let train_sigmas: Vec<f64> = s.sigmas.iter().map(|x| x * diagonal).collect();
-    let (data, _) = labelled_samples(&sampler, &solid, s.samples, &train_sigmas, s.seed)?;
-    if !data.occupancy.iter().any(|&o| o) {
-        return Err(FitError::Input(format!(
-            "{name}: no training sample is inside the mesh (|winding number| < 0.5 everywhere): it encloses no \
-             volume. Close the surface (fill its holes) and try again"
-        )));
-    }
+    let (mut data, num_uniform) = labelled_samples(&sampler, &winding, s.samples, &train_sigmas, s.seed)?;
+    let scale = p.transform.scale;
+    let (target, solid_report) = target::choose(
+        &oracle,
+        &p.unit,
+        &sampler,
+        &mut data,
+        num_uniform,
+        config,
+        diagonal,
+        scale,
+        p.topology.is_closed,
+    )?;
+    let solid = target.solid();
     timings.sample = lap.next();
+    let untrained;
+    let config = if target.initial_sites().is_some() && !config.train_shell {
+        untrained =
+            FitConfig { train: soft_voronoi::TrainConfig { steps: 0, ..config.train.clone() }, ..config.clone() };
+        &untrained
+    } else {
+        config
+    };
 
     progress.stage(Stage::Train);
-    let trainer = train(&data, &solid, config, progress)?;
+    let mut refined_share = None;
+    let initial = match (target.initial_sites(), &config.refine) {
+        (Some(initial), _) => Some(initial),
+        (None, Some(r)) if config.train.init == soft_voronoi::Init::Pairs && config.resume.is_none() => {
+            let area = sampler.total_area();
+            let (sites, labels, share) =
+                crate::grow::refined_pairs(r, &p.transform, &oracle, area, &data, solid, config)?;
+            refined_share = Some(share);
+            Some((sites, labels))
+        }
+        _ => None,
+    };
+    let trainer = train(&data, solid, initial, config, progress)?;
     timings.train = lap.next();
 
     progress.stage(Stage::Crust);
-    let (sites, labels, num_projected) = trainer.final_sites();
+    let (mut sites, mut labels, num_projected) = trainer.final_sites();
+    let num_relabelled =
+        if config.relabel { relabel(&sites, &mut labels, trainer.config().num_sites, solid) } else { 0 };
+    let carving = match config.carve {
+        Some(c) => {
+            let k = trainer.config().num_sites;
+            let tolerance = c * diagonal;
+            let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, tolerance, 4, k / 16)?;
+            r.tolerance_of_diagonal = c;
+            Some(r)
+        }
+        None => None,
+    };
     let checked = crust_of(&sites, &labels, &p.transform, config.output_precision)?;
     let crust_mesh = checked.written.mesh.clone();
     timings.crust = lap.next();
 
     progress.stage(Stage::Evaluate);
-    let quality = misclassification(&sampler, &solid, &sites, &labels, config, diagonal)?;
+    let quality = misclassification(&sampler, solid, &sites, &labels, config, diagonal)?;
     timings.evaluate = lap.next();
 
     progress.stage(Stage::Metrics);
@@ -156,12 +196,17 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
             resumed_from: config.resume.as_ref().map(|r| r.1.clone()),
             threads: rayon::current_num_threads(),
         },
+        solid: solid_report,
         transform: TransformReport { center: p.transform.center, scale: p.transform.scale },
         timings_seconds: timings,
         losses: LossesReport::of(&state),
         quality,
         metrics,
         crust: crust_report(&checked, &crust_mesh, num_projected),
+        refined_share,
+        relabelled_sites: config.relabel.then_some(num_relabelled),
+        carving,
+        accuracy_target: None,
         outputs: OutputsReport::default(),
         total_seconds: t_all.elapsed().as_secs_f64(),
     };
@@ -169,18 +214,24 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     Ok(FitOutput { sites, crust: crust_mesh, state, report })
 }
 
-/// Trains to the end, checkpointing as configured; stops with a checkpoint when
+/// Trains to the end from `initial` sites when given (else `config.train.init`),
+/// checkpointing as configured; stops with a checkpoint when
 /// `progress` asks.
 fn train<'a>(
     data: &'a TrainingData,
-    solid: &'a MeshSolid,
+    solid: &'a dyn Solid,
+    initial: Option<(Vec<[f64; 3]>, Vec<bool>)>,
     config: &FitConfig,
     progress: &mut dyn Progress,
 ) -> Result<Trainer<'a>, FitError> {
     let input = |e: soft_voronoi::TrainError| FitError::Input(e.to_string());
     let mut trainer = match &config.resume {
         Some((state, path)) => Trainer::resume(state.clone(), data, solid, path).map_err(input)?,
-        None => Trainer::new(config.train.clone(), data, solid).map_err(input)?,
+        None => match initial {
+            Some((sites, labels)) => Trainer::from_sites(config.train.clone(), data, solid, sites, labels),
+            None => Trainer::new(config.train.clone(), data, solid),
+        }
+        .map_err(input)?,
     };
     let context = serde_json::to_string(&config.sampling).map_err(|e| FitError::Failure(e.to_string()))?;
     let steps = trainer.config().steps;
@@ -207,11 +258,26 @@ fn train<'a>(
     Ok(trainer)
 }
 
+/// Gives each of the first `k` (trainable) sites the solid's label at its final position and
+/// returns how many changed. A site always lies in its own cell, so a site whose label
+/// disagrees with the solid where it stands (it crossed the surface while training, or
+/// started on the wrong side of a fold) is certainly wrong around itself: it shows as a
+/// spike or a pit in the crust.
+fn relabel(sites: &[[f64; 3]], labels: &mut [bool], k: usize, solid: &dyn Solid) -> usize {
+    let truth = solid.inside(&sites[..k]);
+    let mut changed = 0;
+    for (l, t) in labels[..k].iter_mut().zip(truth) {
+        changed += usize::from(*l != t);
+        *l = t;
+    }
+    changed
+}
+
 /// Misclassification of the hard Voronoi occupancy on a fresh pool (another seed stream
 /// than training: seed XOR [`vf_common::rng::seed_tweak::EVALUATION`]).
 fn misclassification(
     sampler: &SurfaceSampler,
-    solid: &MeshSolid,
+    solid: &dyn Solid,
     sites: &[[f64; 3]],
     labels: &[bool],
     config: &FitConfig,

@@ -32,6 +32,7 @@
 
 mod layout;
 mod raster;
+pub mod raster3d;
 mod svg;
 pub mod ticks;
 

@@ -177,6 +177,24 @@ pub fn pairs_init(
     offset: f64,
     seed: u64,
 ) -> Result<(Vec<[f64; 3]>, Vec<bool>, f64), TrainError> {
+    pairs_init_refined(k, data, solid, offset, seed, &[])
+}
+
+/// [`pairs_init`] with pairs twice as dense where `refine` is true: `refine[i]` flags the
+/// candidate `data.surface[i]` (the first min(12·K, #surface) are candidates; a shorter
+/// slice leaves the rest unflagged). Used to grow K where a previous fit's error was
+/// (`fit`'s accuracy target).
+///
+/// # Errors
+/// As [`pairs_init`].
+pub fn pairs_init_refined(
+    k: usize,
+    data: &TrainingData,
+    solid: &dyn Solid,
+    offset: f64,
+    seed: u64,
+    refine: &[bool],
+) -> Result<(Vec<[f64; 3]>, Vec<bool>, f64), TrainError> {
     let pairs = k / 2;
     let n = data.surface.len();
     if n < pairs.max(2) || data.normals.len() != n {
@@ -187,7 +205,10 @@ pub fn pairs_init(
     // A uniform spacing first, then a cap on each candidate's spacing where the part is
     // thinner (or the surface more folded) than the pairs would be wide there.
     let (_, r0) = poisson_subset(candidates, pairs);
-    let cap = feature_caps(candidates, &data.normals[..m], solid, r0, offset);
+    let mut cap = feature_caps(candidates, &data.normals[..m], solid, r0, offset);
+    for (c, _) in cap.iter_mut().zip(refine).filter(|(_, &r)| r) {
+        *c = c.min(0.5 * r0);
+    }
     let (chosen, spacing) = adaptive_subset(candidates, &cap, pairs);
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 3);
     let mut delta: Vec<f64> = spacing.iter().map(|&h| offset * h).collect();
@@ -250,7 +271,7 @@ pub fn pairs_init(
 /// Greedy Poisson-disk subset of `points` (in order) with `target` points: r is bisected
 /// (on a log scale, 20 rounds) for the largest r giving at least `target` points, and the
 /// first `target` accepted points are returned with r.
-fn poisson_subset(points: &[[f64; 3]], target: usize) -> (Vec<u32>, f64) {
+pub fn poisson_subset(points: &[[f64; 3]], target: usize) -> (Vec<u32>, f64) {
     let (mut lo, mut hi) = (1e-6f64, 1.0f64);
     let mut best = (0..target.min(points.len()) as u32).collect::<Vec<_>>();
     let mut best_r = 0.0;

@@ -27,6 +27,6 @@ pub use config::{Init, TrainConfig, Weights};
 pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};
-pub use solid::{MeshSolid, Sphere};
+pub use solid::{MeshSolid, ShellSolid, Sphere};
 pub use train::{classify, soft_values, StepStats, TrainState, Trainer, TrainingData};
 pub use vf_common::AdamParams;

@@ -100,6 +100,11 @@ pub struct Located {
 pub trait Solid: Sync {
     /// Locates every point (any thread count; the result must not depend on it).
     fn locate(&self, points: &[[f64; 3]]) -> Vec<Located>;
+
+    /// Inside test only (solids with a cheaper test than [`Solid::locate`] override it).
+    fn inside(&self, points: &[[f64; 3]]) -> Vec<bool> {
+        self.locate(points).into_iter().map(|l| l.inside).collect()
+    }
 }
 
 /// Signed-distance regulariser: (1/K) Σ_k dist(p_k, S_k) where S_k is the solid for an

@@ -17,9 +17,9 @@ pub struct MeshSolid<'a> {
     pub oracle: &'a MeshOracle,
 }
 
-impl MeshSolid<'_> {
+impl Solid for MeshSolid<'_> {
     /// Inside test for each point ([`MeshOracle::is_inside`]).
-    pub fn inside(&self, points: &[[f64; 3]]) -> Vec<bool> {
+    fn inside(&self, points: &[[f64; 3]]) -> Vec<bool> {
         let mut out = vec![false; points.len()];
         out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(o, ps)| {
             let mut ws = Workspace::new();
@@ -29,9 +29,7 @@ impl MeshSolid<'_> {
         });
         out
     }
-}
 
-impl Solid for MeshSolid<'_> {
     fn locate(&self, points: &[[f64; 3]]) -> Vec<Located> {
         let mut out = vec![Located { inside: false, closest: [0.0; 3] }; points.len()];
         out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(o, ps)| {
@@ -43,6 +41,64 @@ impl Solid for MeshSolid<'_> {
             }
         });
         out
+    }
+}
+
+/// A surface thickened into a solid: the points within `half_thickness` of the mesh (an
+/// offset band, closed by half-cylinders along open boundaries). This is the target when the
+/// mesh encloses no volume (a zero-thickness sheet, a lone open patch), where the winding
+/// number rule of [`MeshSolid`] would leave nothing inside.
+pub struct ShellSolid<'a> {
+    /// The oracle, built on the mesh in the frame of the queries (closest points by BVH).
+    pub oracle: &'a MeshOracle,
+    /// Unit normal of each triangle of the oracle's mesh (any orientation): the direction
+    /// off the band's middle for a point exactly on the mesh.
+    pub normals: Vec<[f64; 3]>,
+    /// Half the band's thickness, in the frame of the queries (> 0).
+    pub half_thickness: f64,
+}
+
+impl<'a> ShellSolid<'a> {
+    /// The band of half-thickness `half_thickness` around `mesh` (the mesh `oracle` was
+    /// built on, same frame).
+    pub fn new(oracle: &'a MeshOracle, mesh: &mesh_io::TriMesh, half_thickness: f64) -> Self {
+        let normals = (0..mesh.triangles.len()).map(|t| unit_normal(mesh, t)).collect();
+        ShellSolid { oracle, normals, half_thickness }
+    }
+}
+
+impl Solid for ShellSolid<'_> {
+    fn locate(&self, points: &[[f64; 3]]) -> Vec<Located> {
+        let h = self.half_thickness;
+        let mut out = vec![Located { inside: false, closest: [0.0; 3] }; points.len()];
+        out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(o, ps)| {
+            let mut ws = Workspace::new();
+            for (o, &p) in o.iter_mut().zip(ps) {
+                let c = self.oracle.closest_point(p, &mut ws);
+                let d = c.squared_distance.sqrt();
+                let dir = if d > 1e-12 * h {
+                    [0, 1, 2].map(|i| (p[i] - c.point[i]) / d)
+                } else {
+                    self.normals.get(c.triangle as usize).copied().unwrap_or([0.0, 0.0, 1.0])
+                };
+                *o = Located { inside: d <= h, closest: [0, 1, 2].map(|i| c.point[i] + h * dir[i]) };
+            }
+        });
+        out
+    }
+}
+
+/// Unit normal of triangle `t` of `mesh` (counter-clockwise orientation; z for a
+/// degenerate triangle).
+pub fn unit_normal(mesh: &mesh_io::TriMesh, t: usize) -> [f64; 3] {
+    let [a, b, c] = mesh.triangles[t].map(|v| mesh.positions[v as usize]);
+    let (u, v) = ([0, 1, 2].map(|i| b[i] - a[i]), [0, 1, 2].map(|i| c[i] - a[i]));
+    let n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if l > 0.0 {
+        n.map(|x| x / l)
+    } else {
+        [0.0, 0.0, 1.0]
     }
 }
 

@@ -132,7 +132,7 @@ impl<'a> Trainer<'a> {
         config.validate()?;
         data.validate()?;
         let k = config.num_sites;
-        let (mut sites, mut labels) = match config.init {
+        let (sites, labels) = match config.init {
             Init::Paper => paper_init(k, config.seed),
             Init::Samples => samples_init(k, data, config.seed)?,
             Init::Surface => surface_init(k, data, solid, config.surface_offset, config.seed)?,
@@ -141,6 +141,36 @@ impl<'a> Trainer<'a> {
                 (sites, labels)
             }
         };
+        Self::from_sites(config, data, solid, sites, labels)
+    }
+
+    /// Starts from sites placed by the caller (an initialisation that needs more than
+    /// `data` and the solid, such as the fit's triplets across a thin shell) instead of
+    /// `config.init`: `sites` and `labels` are the K trainable sites; the boundary sites
+    /// and the optimiser are set up as in [`Trainer::new`].
+    ///
+    /// # Errors
+    /// Invalid settings or data; not exactly K finite sites in the unit cube with labels.
+    pub fn from_sites(
+        config: TrainConfig,
+        data: &'a TrainingData,
+        solid: &'a dyn Solid,
+        mut sites: Vec<[f64; 3]>,
+        mut labels: Vec<bool>,
+    ) -> Result<Self, TrainError> {
+        config.validate()?;
+        data.validate()?;
+        let k = config.num_sites;
+        if sites.len() != k || labels.len() != k {
+            return Err(TrainError::Data(format!(
+                "{} initial sites with {} labels; the settings ask for {k}",
+                sites.len(),
+                labels.len()
+            )));
+        }
+        if let Some(i) = sites.iter().position(|p| !p.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))) {
+            return Err(TrainError::Data(format!("initial site {i} is not in the unit cube: {:?}", sites[i])));
+        }
         let boundary = boundary_sites(config.boundary_sites.unwrap_or_else(|| (k as f64).sqrt().ceil() as usize));
         debug_assert_eq!(boundary.len(), config.num_boundary());
         labels.extend(std::iter::repeat_n(false, boundary.len()));

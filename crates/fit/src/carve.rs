@@ -1,0 +1,121 @@
+//! Site insertion where the crust strays: after training, at the foot c (closest input
+//! point) of every crust vertex farther than a tolerance t from the input, a mirrored pair
+//! c ± t·n (n: the normal of the input's triangle there) is inserted, labelled by the solid,
+//! and the crust is extracted again, for a few rounds. A spike of crust (an inside cell
+//! poking out between outside sites at an ear tip or a corner) stands over its foot; the
+//! pair's bisector is the tangent plane at c, and the outside site is nearer to the spike
+//! than the sites that made it, so the spike is cut back to the surface there. (A single
+//! site at the stray vertex itself was tried first: its cell, bounded only by the sites of
+//! an empty sphere, can be larger than the spike and made the farthest vertex farther.)
+
+use crust::{Crust, CrustConfig};
+use mesh_io::TriMesh;
+use occupancy::MeshOracle;
+use serde::Serialize;
+use soft_voronoi::Solid;
+
+use crate::error::FitError;
+
+/// What [`carve`] did (report field `carving`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CarveReport {
+    /// The tolerance, unit-cube lengths (and as a share of the diagonal).
+    pub tolerance: f64,
+    /// The same as a share of the input's bounding-box diagonal.
+    pub tolerance_of_diagonal: f64,
+    /// Sites inserted, per round.
+    pub inserted_per_round: Vec<usize>,
+    /// Farthest crust vertex from the input before and after, unit-cube lengths.
+    pub farthest_before: f64,
+    /// After the last kept round.
+    pub farthest_after: f64,
+    /// Rounds run but undone: the best state (least farthest vertex, then least summed
+    /// excess distance of the stray vertices) came before them.
+    pub undone_rounds: usize,
+}
+
+/// Inserts pairs of sites (appended to `sites` and `labels`) at the feet of the crust's
+/// vertices farther than `tolerance` from `mesh` (the mesh behind `oracle`, same frame),
+/// labelled by `solid`, for up to `rounds` rounds and at most `max_new` sites in all
+/// (farthest first; feet closer than 2·`tolerance` to an earlier one are skipped), then
+/// keeps the best of the states reached (see [`CarveReport::undone_rounds`]).
+///
+/// # Errors
+/// [`FitError::Failure`] when a crust cannot be extracted.
+#[allow(clippy::too_many_arguments)]
+pub fn carve(
+    sites: &mut Vec<[f64; 3]>,
+    labels: &mut Vec<bool>,
+    oracle: &MeshOracle,
+    mesh: &TriMesh,
+    solid: &dyn Solid,
+    tolerance: f64,
+    rounds: usize,
+    max_new: usize,
+) -> Result<CarveReport, FitError> {
+    let mut report = CarveReport { tolerance, ..Default::default() };
+    let mut budget = max_new;
+    // After each round's extraction: (sites so far, farthest vertex, summed excess Σ(d − t)
+    // over stray vertices). Rounds need not help one by one (cutting one spike can expose
+    // the next), so all of them run and the best state — least farthest vertex, then least
+    // excess — is kept: carving never leaves the crust worse than it found it.
+    let mut states: Vec<(usize, f64, f64)> = Vec::new();
+    for round in 0..=rounds {
+        let crust = Crust::extract(sites, labels, &CrustConfig::default())
+            .map_err(|e| FitError::Failure(format!("crust while carving: {e}")))?;
+        let far =
+            oracle.closest_points(&crust.mesh.positions).map_err(|e| FitError::Failure(format!("carving: {e}")))?;
+        let farthest = far.iter().map(|c| c.squared_distance.sqrt()).fold(0.0, f64::max);
+        let excess: f64 = far.iter().map(|c| (c.squared_distance.sqrt() - tolerance).max(0.0)).sum();
+        states.push((sites.len(), farthest, excess));
+        let mut stray: Vec<(f64, [f64; 3], u32)> = far
+            .iter()
+            .map(|c| (c.squared_distance.sqrt(), c.point, c.triangle))
+            .filter(|&(d, _, _)| d > tolerance)
+            .collect();
+        if round == rounds || stray.is_empty() || budget < 2 {
+            break;
+        }
+        stray.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.map(f64::to_bits).cmp(&b.1.map(f64::to_bits))));
+        let mut feet: Vec<[f64; 3]> = Vec::new();
+        let mut new: Vec<[f64; 3]> = Vec::new();
+        for &(_, c, t) in &stray {
+            if new.len() + 2 > budget {
+                break;
+            }
+            if feet.iter().any(|f| dist2(*f, c) < 4.0 * tolerance * tolerance) {
+                continue;
+            }
+            feet.push(c);
+            let n = soft_voronoi::solid::unit_normal(mesh, t as usize);
+            new.extend([1.0, -1.0].map(|s| [0, 1, 2].map(|i| (c[i] + s * tolerance * n[i]).clamp(1e-6, 1.0 - 1e-6))));
+        }
+        // Each pair is labelled by the solid, whatever it gives: at a thin tip both sites of
+        // a pair may land outside (or inside), and two outside sites there are exactly what
+        // cuts a spike back. (Keeping only pairs that straddle the surface, as the initial
+        // pairs do, left the bunny's ear-tip spikes untouched.) A round that does harm is
+        // undone by the choice of the best state below.
+        let kept = new.len();
+        labels.extend(solid.inside(&new));
+        sites.extend(new);
+        if kept == 0 {
+            break;
+        }
+        budget -= kept;
+        report.inserted_per_round.push(kept);
+    }
+    let best = (0..states.len())
+        .min_by(|&i, &j| states[i].1.total_cmp(&states[j].1).then(states[i].2.total_cmp(&states[j].2)).then(i.cmp(&j)))
+        .unwrap_or(0);
+    report.farthest_before = states[0].1;
+    report.farthest_after = states[best].1;
+    report.undone_rounds = report.inserted_per_round.len() - best;
+    report.inserted_per_round.truncate(best);
+    sites.truncate(states[best].0);
+    labels.truncate(states[best].0);
+    Ok(report)
+}
+
+fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
+}

@@ -1,0 +1,269 @@
+//! The solid the sites fit: the mesh's winding-number solid, or, when that holds (almost)
+//! nothing — a zero-thickness sheet, a lone open patch — the surface thickened into a thin
+//! shell ([`ShellSolid`]), said in the report and the summary.
+
+use std::collections::HashMap;
+
+use mesh_io::TriMesh;
+use occupancy::sample::SurfaceSampler;
+use occupancy::MeshOracle;
+use serde::Serialize;
+use soft_voronoi::init::poisson_subset;
+use soft_voronoi::{MeshSolid, ShellSolid, Solid, TrainingData};
+use vf_common::rng::{ChunkRng, Stream};
+
+use crate::config::{shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE};
+use crate::error::FitError;
+
+/// The solid in use; the shell comes with its own initial sites ([`shell_sites`]).
+pub(crate) enum Target<'a> {
+    Winding(MeshSolid<'a>),
+    Shell(ShellSolid<'a>, Vec<[f64; 3]>, Vec<bool>),
+}
+
+impl Target<'_> {
+    pub(crate) fn solid(&self) -> &dyn Solid {
+        match self {
+            Target::Winding(s) => s,
+            Target::Shell(s, ..) => s,
+        }
+    }
+
+    /// Initial sites and labels when the target places them itself (the shell).
+    pub(crate) fn initial_sites(&self) -> Option<(Vec<[f64; 3]>, Vec<bool>)> {
+        match self {
+            Target::Winding(_) => None,
+            Target::Shell(_, sites, labels) => Some((sites.clone(), labels.clone())),
+        }
+    }
+}
+
+/// Which solid was fitted and why (report field `solid`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SolidReport {
+    /// `winding` or `shell`.
+    pub rule: SolidRule,
+    /// `auto` (chosen from the share below) or `--solid` (asked for).
+    pub chosen_by: &'static str,
+    /// Share of the near-surface training samples inside the winding-number solid.
+    pub near_surface_inside_share: f64,
+    /// Share of near-surface samples with 0.25 < |w| < 0.75 (auto takes the shell for an
+    /// open mesh at [`SHELL_ABOVE`] or more).
+    pub near_surface_ambiguous_share: f64,
+    /// Half the shell's thickness in input units (shell only).
+    pub half_thickness: Option<f64>,
+    /// The same as a fraction of the input's bounding-box diagonal.
+    pub half_thickness_of_diagonal: Option<f64>,
+    /// How the shell's sites start (shell only; see [`shell_sites`]).
+    pub init: Option<String>,
+}
+
+/// Chooses the solid for `data` (labelled by `winding`, near-surface samples from
+/// `num_uniform` on; `is_closed`: the mesh's topology) and, for the shell, relabels the pool and moves its surface points onto
+/// the shell's two sides (alternately). `scale`: input units per unit-cube length.
+///
+/// # Errors
+/// [`FitError::Input`] when the winding-number solid is asked for and holds nothing.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn choose<'a>(
+    oracle: &'a MeshOracle,
+    unit: &TriMesh,
+    sampler: &SurfaceSampler,
+    data: &mut TrainingData,
+    num_uniform: usize,
+    config: &FitConfig,
+    diagonal: f64,
+    scale: f64,
+    is_closed: bool,
+) -> Result<(Target<'a>, SolidReport), FitError> {
+    let near = &data.occupancy[num_uniform..];
+    let share = near.iter().filter(|&&o| o).count() as f64 / near.len().max(1) as f64;
+    let probe = &data.points[num_uniform..data.points.len().min(num_uniform + AMBIGUITY_SAMPLES)];
+    let w = oracle
+        .winding_numbers(probe, occupancy::WindingMode::Fast)
+        .map_err(|e| FitError::Failure(format!("winding numbers: {e}")))?;
+    let ambiguous = w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64;
+    let s = &config.sampling;
+    let nothing_inside = !data.occupancy.iter().any(|&o| o);
+    let (shell, chosen_by) = match s.solid {
+        SolidRule::Auto => (!is_closed && (ambiguous >= SHELL_ABOVE || nothing_inside), "auto"),
+        SolidRule::Winding => (false, "--solid"),
+        SolidRule::Shell => (true, "--solid"),
+    };
+    if !shell {
+        if nothing_inside {
+            return Err(FitError::Input(format!(
+                "{}: no training sample is inside the mesh (|winding number| < 0.5 everywhere): it encloses no \
+                 volume. Close the surface (fill its holes), or fit a thin shell around it with --solid shell",
+                s.mesh
+            )));
+        }
+        let report = SolidReport {
+            rule: SolidRule::Winding,
+            chosen_by,
+            near_surface_inside_share: share,
+            near_surface_ambiguous_share: ambiguous,
+            half_thickness: None,
+            half_thickness_of_diagonal: None,
+            init: None,
+        };
+        return Ok((Target::Winding(MeshSolid { oracle }), report));
+    }
+    let h = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
+    let solid = ShellSolid::new(oracle, unit, h);
+    data.occupancy = solid.inside(&data.points);
+    let k = config.train.num_sites;
+    let m = data.surface.len().min(12 * k);
+    let (sites, labels, (triplets, rims)) = shell_sites(
+        unit,
+        sampler.total_area(),
+        &data.surface[..m],
+        &data.normals[..m],
+        &solid,
+        k,
+        data,
+        config.train.seed,
+    );
+    for (i, (p, n)) in data.surface.iter_mut().zip(&data.normals).enumerate() {
+        let side = if i % 2 == 0 { h } else { -h };
+        *p = [0, 1, 2].map(|c| p[c] + side * n[c]);
+    }
+    let report = SolidReport {
+        rule: SolidRule::Shell,
+        chosen_by,
+        near_surface_inside_share: share,
+        near_surface_ambiguous_share: ambiguous,
+        half_thickness: Some(h / scale),
+        half_thickness_of_diagonal: Some(h / diagonal),
+        init: Some(format!(
+            "{triplets} triplets (inside on the surface, outside at ±2h along the normal) and {rims} rim quadruplets \
+             (one more outside site 2h beyond the open boundary){}",
+            if config.train_shell {
+                ", then trained"
+            } else {
+                ", kept as constructed (no training unless --steps is given)"
+            }
+        )),
+    };
+    Ok((Target::Shell(solid, sites, labels), report))
+}
+
+/// Initial sites for the shell of half-thickness h around `unit`: at Poisson-disk points p
+/// of the surface (from `surface`, area-uniform, with `normals`) an inside site at p and
+/// outside sites at p ± 2h·n, whose bisectors are the shell's two sides (exactly, on a flat
+/// part, whatever the spacing); along open boundary edges (meshes welded by position) the
+/// same plus an outside site 2h beyond the edge in the surface's plane, which closes the
+/// band there. Points are spread so that 3 per surface point and 4 per rim point make K;
+/// labels come from the solid (folds closer than 2h turn outside sites inside); unused
+/// slots are filled with training samples. Returns sites, labels and the two counts.
+#[allow(clippy::too_many_arguments)]
+fn shell_sites(
+    unit: &TriMesh,
+    area: f64,
+    surface: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    solid: &ShellSolid,
+    k: usize,
+    data: &TrainingData,
+    seed: u64,
+) -> (Vec<[f64; 3]>, Vec<bool>, (usize, usize)) {
+    let h = solid.half_thickness;
+    let rim = boundary_edges(unit);
+    let length: f64 = rim.iter().map(|e| dist(e.0, e.1)).sum();
+    // 3·A/s² + 4·L/s = K for the spacing s.
+    let u = (-4.0 * length + (16.0 * length * length + 12.0 * area * k as f64).sqrt()) / (6.0 * area).max(1e-300);
+    let s = 1.0 / u.max(1e-300);
+    let mut rim_points: Vec<([f64; 3], [f64; 3], [f64; 3])> = Vec::new();
+    for &(a, b, n, d) in &rim_with_frames(unit, &rim) {
+        let count = (dist(a, b) / s).ceil().max(1.0) as usize;
+        for j in 0..count {
+            let t = (j as f64 + 0.5) / count as f64;
+            rim_points.push(([0, 1, 2].map(|c| a[c] + t * (b[c] - a[c])), n, d));
+        }
+    }
+    rim_points.truncate(k / 4);
+    let triplets = (k - 4 * rim_points.len()) / 3;
+    let (chosen, _) = poisson_subset(surface, triplets.min(surface.len()));
+    let clamp = |p: [f64; 3]| p.map(|x| x.clamp(1e-6, 1.0 - 1e-6));
+    let along = |p: [f64; 3], v: [f64; 3], f: f64| clamp([0, 1, 2].map(|c| p[c] + f * v[c]));
+    let mut sites = Vec::with_capacity(k);
+    for &i in &chosen {
+        let (p, n) = (surface[i as usize], normals[i as usize]);
+        sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h)]);
+    }
+    for &(p, n, d) in &rim_points {
+        sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h), along(p, d, 2.0 * h)]);
+    }
+    let mut labels = solid.inside(&sites);
+    let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 5);
+    while sites.len() < k {
+        let i = (rng.next_u64() % data.points.len() as u64) as usize;
+        sites.push(data.points[i]);
+        labels.push(data.occupancy[i]);
+    }
+    (sites, labels, (chosen.len(), rim_points.len()))
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Open boundary edges (one incident triangle), with vertices identified by position so a
+/// soup of triangles sharing corners has no false boundary: (a, b, triangle).
+fn boundary_edges(mesh: &TriMesh) -> Vec<([f64; 3], [f64; 3], u32)> {
+    let mut id: HashMap<[u64; 3], u32> = HashMap::new();
+    let canon: Vec<u32> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let next = id.len() as u32;
+            *id.entry(p.map(f64::to_bits)).or_insert(next)
+        })
+        .collect();
+    let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (canon[tri[e] as usize], canon[tri[(e + 1) % 3] as usize]);
+            if a != b {
+                let entry = edges.entry((a.min(b), a.max(b))).or_insert((0, t as u32));
+                entry.0 += 1;
+            }
+        }
+    }
+    let mut out: Vec<([f64; 3], [f64; 3], u32)> = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for e in 0..3 {
+            let (va, vb) = (tri[e] as usize, tri[(e + 1) % 3] as usize);
+            let (a, b) = (canon[va], canon[vb]);
+            if a != b && edges[&(a.min(b), a.max(b))] == (1, t as u32) {
+                out.push((mesh.positions[va], mesh.positions[vb], t as u32));
+            }
+        }
+    }
+    out
+}
+
+/// Each boundary edge with its triangle's unit normal n and the unit direction d in the
+/// triangle's plane, across the edge and away from the triangle (degenerate triangles are
+/// skipped).
+fn rim_with_frames(mesh: &TriMesh, rim: &[([f64; 3], [f64; 3], u32)]) -> Vec<([f64; 3], [f64; 3], [f64; 3], [f64; 3])> {
+    let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross =
+        |u: [f64; 3], v: [f64; 3]| [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    let unit = |v: [f64; 3]| {
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        (l > 0.0).then(|| v.map(|x| x / l))
+    };
+    rim.iter()
+        .filter_map(|&(a, b, t)| {
+            let [p, q, r] = mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
+            let n = unit(cross(sub(q, p), sub(r, p)))?;
+            let mut d = unit(cross(sub(b, a), n))?;
+            let centroid = [0, 1, 2].map(|c| (p[c] + q[c] + r[c]) / 3.0);
+            if (0..3).map(|c| d[c] * (centroid[c] - a[c])).sum::<f64>() > 0.0 {
+                d = d.map(|x| -x);
+            }
+            Some((a, b, n, d))
+        })
+        .collect()
+}

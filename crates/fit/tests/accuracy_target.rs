@@ -1,0 +1,63 @@
+//! Asking for an accuracy instead of a K: the fit doubles K, refining where the previous
+//! crust missed, until the certified Hausdorff meets the goal or the budget is spent; the
+//! report carries the K used and the error-against-K trace.
+
+use fit::{fit_to_accuracy, AccuracyGoal, FitConfig, FitError, NoProgress};
+use mesh_io::shapes::icosphere;
+
+fn small(k: usize) -> FitConfig {
+    let mut c = FitConfig::new("sphere", k);
+    c.train.steps = 60;
+    c.train.batch = 4096;
+    c.sampling.samples = 60_000;
+    c.eval.samples = 20_000;
+    c
+}
+
+#[test]
+fn grows_until_the_goal_is_met_and_reports_the_trace() {
+    let sphere = icosphere(3);
+    // A goal the first round misses (128 sites on a sphere: a few % of the diagonal).
+    let first = fit::fit(&sphere, &small(128), &mut NoProgress).unwrap();
+    let h0 = match &first.report.metrics {
+        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / sphere.diagonal(),
+        other => panic!("{other:?}"),
+    };
+    let goal = AccuracyGoal { hausdorff_of_diagonal: 0.5 * h0, max_sites: 2048 };
+    let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
+    let a = out.report.accuracy_target.as_ref().expect("the trace");
+    let sites: Vec<usize> = a.trace.iter().map(|r| r.sites).collect();
+    assert!(sites.len() >= 2, "the first round cannot meet half its own error: {sites:?}");
+    assert!(sites.windows(2).all(|w| w[1] == 2 * w[0]), "{sites:?}");
+    assert!((a.trace[0].hausdorff_hi_of_diagonal - h0).abs() < 1e-12, "the same first fit (seeded)");
+    assert!(
+        a.trace[1..].iter().all(|r| r.refined_share > 0.0),
+        "later rounds refine where the error was: {:?}",
+        a.trace
+    );
+    let last = a.trace.last().unwrap();
+    assert_eq!(a.sites_used, last.sites);
+    assert_eq!(out.report.settings.train.num_sites, last.sites);
+    assert_eq!(a.met, last.hausdorff_hi_of_diagonal <= goal.hausdorff_of_diagonal);
+    assert!(a.met || last.sites * 2 > goal.max_sites, "stopped early without meeting the goal");
+    assert!(out.report.crust.is_closed && out.report.crust.is_manifold);
+    assert!(out.report.summary().contains("Accuracy target"));
+    let json = serde_json::to_value(&out.report).unwrap();
+    assert!(json["accuracy_target"]["trace"].as_array().unwrap().len() == a.trace.len());
+}
+
+#[test]
+fn an_easy_goal_stops_at_the_first_round_and_bad_goals_are_refused() {
+    let sphere = icosphere(2);
+    let goal = AccuracyGoal { hausdorff_of_diagonal: 0.5, max_sites: 1024 };
+    let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
+    let a = out.report.accuracy_target.unwrap();
+    assert!(a.met && a.trace.len() == 1 && a.sites_used == 128);
+    for goal in [
+        AccuracyGoal { hausdorff_of_diagonal: 0.0, max_sites: 1024 },
+        AccuracyGoal { hausdorff_of_diagonal: f64::NAN, max_sites: 1024 },
+        AccuracyGoal { hausdorff_of_diagonal: 0.01, max_sites: 64 },
+    ] {
+        assert!(matches!(fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress), Err(FitError::Input(_))));
+    }
+}

@@ -1,0 +1,66 @@
+//! Site insertion where the crust strays (`fit::carve`): a gap in the outside sites over a
+//! sphere's pole lets the inside cells poke out as a spike; pairs inserted at the spike's
+//! feet cut it back, and the crust stays valid. On the whole job it is opt-in (`--carve`).
+
+use fit::carve::carve;
+use mesh_io::shapes::icosphere;
+use mesh_io::{TriMesh, UnitCubeTransform};
+use occupancy::MeshOracle;
+use soft_voronoi::{MeshSolid, Solid};
+
+/// Mirrored pairs c + (r ± δ)·n at `n` Fibonacci directions, without the outside sites
+/// whose direction has z above `gap` (the spike's gap), plus the fixed boundary sites.
+fn pairs_with_a_gap(center: [f64; 3], r: f64, n: usize, gap: f64) -> (Vec<[f64; 3]>, Vec<bool>) {
+    let delta = 0.5 * r * (4.0 * std::f64::consts::PI / n as f64).sqrt();
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let (mut sites, mut labels) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let (s, a) = ((1.0 - z * z).sqrt(), golden * i as f64);
+        let d = [s * a.cos(), s * a.sin(), z];
+        for (rr, inside) in [(r - delta, true), (r + delta, false)] {
+            if !inside && z > gap {
+                continue;
+            }
+            sites.push([0, 1, 2].map(|c| center[c] + rr * d[c]));
+            labels.push(inside);
+        }
+    }
+    for b in soft_voronoi::init::boundary_sites(96) {
+        sites.push(b);
+        labels.push(false);
+    }
+    (sites, labels)
+}
+
+fn farthest(sites: &[[f64; 3]], labels: &[bool], oracle: &MeshOracle) -> f64 {
+    let crust = crust::Crust::extract(sites, labels, &crust::CrustConfig::default()).unwrap();
+    oracle.closest_points(&crust.mesh.positions).unwrap().iter().map(|c| c.squared_distance.sqrt()).fold(0.0, f64::max)
+}
+
+#[test]
+fn pairs_at_the_feet_cut_a_spike_back() {
+    let sphere = icosphere(5);
+    let t = UnitCubeTransform::of_mesh(&sphere, 0.05).unwrap();
+    let unit: TriMesh = t.mesh_to_unit(&sphere);
+    let oracle = MeshOracle::from_mesh(&unit, &occupancy::Config::default()).unwrap();
+    let solid = MeshSolid { oracle: &oracle };
+    let r = 0.45;
+    let (mut sites, mut labels) = pairs_with_a_gap([0.5; 3], r, 2000, 0.995);
+    let before = farthest(&sites, &labels, &oracle);
+    assert!(before > 0.02, "the gap makes a spike: {before}");
+    let tolerance = 0.004;
+    let n0 = sites.len();
+    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 4, 400).unwrap();
+    let inserted: usize = report.inserted_per_round.iter().sum();
+    assert_eq!(sites.len(), n0 + inserted);
+    assert!(inserted > 0 && inserted % 2 == 0, "{report:?}");
+    assert!((report.farthest_before - before).abs() < 1e-12);
+    assert!(report.farthest_after < 0.5 * before, "{report:?}");
+    assert!((farthest(&sites, &labels, &oracle) - report.farthest_after).abs() < 1e-12);
+    // The pairs are labelled by the solid (on a smooth sphere: one inside, one outside).
+    let new_labels = &labels[n0..];
+    assert_eq!(solid.inside(&sites[n0..]), new_labels);
+    assert!(new_labels.chunks(2).all(|p| p[0] != p[1]), "{new_labels:?}");
+    assert!(report.farthest_after <= report.farthest_before);
+}

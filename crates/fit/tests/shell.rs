@@ -1,0 +1,145 @@
+//! Surfaces without volume: a zero-thickness sheet and a lone open patch fit a thin shell
+//! (the surface thickened by a band, stated in the report) instead of being refused; closed
+//! meshes keep the winding-number solid; a mesh with no area is still refused.
+
+use fit::{FitConfig, FitError, NoProgress, SolidRule};
+use mesh_io::shapes::icosphere;
+use mesh_io::TriMesh;
+
+fn small(name: &str) -> FitConfig {
+    let mut c = FitConfig::new(name, 1024);
+    c.train.steps = 80;
+    c.train.batch = 4096;
+    c.sampling.samples = 60_000;
+    c.eval.samples = 40_000;
+    c
+}
+
+/// An n×n grid of squares (two triangles each) on the unit square, z = 0.
+fn sheet(n: u32) -> TriMesh {
+    let mut positions = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            positions.push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
+        }
+    }
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let mut triangles = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    TriMesh { positions, triangles }
+}
+
+#[test]
+fn a_flat_sheet_fits_a_thin_shell() {
+    let out = fit::fit(&sheet(8), &small("sheet"), &mut NoProgress).unwrap();
+    let s = &out.report.solid;
+    assert_eq!(s.rule, SolidRule::Shell);
+    assert_eq!(s.chosen_by, "auto");
+    assert!(s.near_surface_ambiguous_share > 0.9, "{}", s.near_surface_ambiguous_share);
+    let h = s.half_thickness.unwrap();
+    assert!(h > 0.0 && h < 0.05 * 2f64.sqrt(), "half-thickness {h}");
+    let c = &out.report.crust;
+    assert!(c.is_closed && c.is_manifold, "{c:?}");
+    assert_eq!(c.num_components, 1, "one connected slab");
+    // A slab around the square: its volume is about area × 2h, and it stays near the sheet.
+    let v = c.volume.abs();
+    assert!(v > 0.5 * 2.0 * h && v < 2.0 * 2.0 * h, "volume {v} for half-thickness {h}");
+    let far = out.crust.positions.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
+    assert!(far < 4.0 * h, "a crust vertex {far} off the sheet (h = {h})");
+    assert!(out.report.quality.misclassification < 0.02, "{}", out.report.quality.misclassification);
+    assert!(out.report.summary().contains("thin shell"), "{}", out.report.summary());
+    assert_eq!(out.report.settings.train.steps, 0, "kept as constructed");
+    // Asked to train, it trains (and stays a closed slab).
+    let mut c = small("sheet");
+    c.train_shell = true;
+    let trained = fit::fit(&sheet(8), &c, &mut NoProgress).unwrap();
+    assert_eq!(trained.report.settings.train.steps, 80);
+    assert!(trained.report.crust.is_closed && trained.report.crust.num_components == 1);
+}
+
+/// A saddle-shaped patch and a spherical cap (whose concave side holds a sliver where
+/// |w| ≥ 0.5, not a solid) get the shell; a sphere with a hole and a closed sphere keep the
+/// winding-number solid.
+#[test]
+fn open_patches_and_closed_meshes_get_the_right_solid() {
+    let mut saddle = sheet(8);
+    for p in &mut saddle.positions {
+        p[2] = 0.3 * ((p[0] - 0.5).powi(2) - (p[1] - 0.5).powi(2));
+    }
+    let out = fit::fit(&saddle, &small("saddle"), &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.rule, SolidRule::Shell, "{}", out.report.solid.near_surface_ambiguous_share);
+    assert!(out.report.crust.is_closed && out.report.crust.num_components == 1);
+    assert!(out.report.quality.misclassification < 0.02, "{}", out.report.quality.misclassification);
+    let sphere = icosphere(3);
+    let cap = TriMesh {
+        positions: sphere.positions.clone(),
+        triangles: sphere
+            .triangles
+            .iter()
+            .copied()
+            .filter(|t| t.iter().all(|&v| sphere.positions[v as usize][2] > 0.6))
+            .collect(),
+    };
+    let out = fit::fit(&cap, &small("cap"), &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.rule, SolidRule::Shell, "{}", out.report.solid.near_surface_ambiguous_share);
+    let holed = TriMesh {
+        positions: sphere.positions.clone(),
+        triangles: sphere
+            .triangles
+            .iter()
+            .copied()
+            .filter(|t| t.iter().any(|&v| sphere.positions[v as usize][2] < 0.9))
+            .collect(),
+    };
+    let out = fit::fit(&holed, &small("holed"), &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.rule, SolidRule::Winding, "{}", out.report.solid.near_surface_ambiguous_share);
+    let out = fit::fit(&sphere, &small("sphere"), &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.rule, SolidRule::Winding);
+    assert!(out.report.solid.near_surface_inside_share > 0.3);
+    assert!(out.report.solid.near_surface_ambiguous_share < 0.01);
+    assert!(out.report.solid.half_thickness.is_none());
+    assert!(!out.report.summary().contains("thin shell"));
+}
+
+#[test]
+fn asking_for_the_winding_solid_of_a_sheet_is_refused_with_the_way_out() {
+    let mut c = small("sheet");
+    c.sampling.solid = SolidRule::Winding;
+    match fit::fit(&sheet(4), &c, &mut NoProgress) {
+        Err(e @ FitError::Input(_)) => assert!(e.to_string().contains("--solid shell"), "{e}"),
+        Err(e) => panic!("wrong error: {e}"),
+        Ok(_) => panic!("a sheet has no winding-number volume"),
+    }
+}
+
+#[test]
+fn an_explicit_thickness_is_used_and_checked() {
+    let mut c = small("sheet");
+    c.sampling.solid = SolidRule::Shell;
+    c.sampling.shell_thickness = Some(0.04);
+    let mesh = sheet(4);
+    let out = fit::fit(&mesh, &c, &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.chosen_by, "--solid");
+    let f = out.report.solid.half_thickness_of_diagonal.unwrap();
+    assert!((f - 0.02).abs() < 1e-12, "{f}");
+    c.sampling.shell_thickness = Some(-1.0);
+    assert!(matches!(fit::fit(&mesh, &c, &mut NoProgress), Err(FitError::Input(_))));
+}
+
+#[test]
+fn a_mesh_without_area_is_still_refused() {
+    let mesh = TriMesh {
+        positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        triangles: vec![[0, 1, 2], [0, 1, 1]],
+    };
+    match fit::fit(&mesh, &small("line"), &mut NoProgress) {
+        Err(e @ FitError::Input(_)) => assert!(e.to_string().contains("area"), "{e}"),
+        Err(e) => panic!("wrong error: {e}"),
+        Ok(_) => panic!("a mesh with no area has nothing to fit"),
+    }
+}
