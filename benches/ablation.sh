@@ -18,17 +18,23 @@ if [ ${#MESHES[@]} -eq 0 ]; then
   MESHES=(assets/bunny.obj ../shared/meshes/alecjacobson__spot.obj ../shared/meshes/mikedh__featuretype.STL)
 fi
 declare -a NAMES=(
-  "previous default (random pairs, δ = ¼ spacing, seed losses only, lr 3e-5)"
+  "first default (random pairs, δ = ¼ spacing, seed losses only, lr 3e-5)"
   "pairs init, seed losses only"
   "default without the normal alignment"
+  "default with normal alignment 0.1 (the previous default)"
   "default with δ = ½ spacing"
+  "default without carving"
+  "default without relabelling and carving"
   "default"
 )
 declare -a FLAGS=(
-  "--init surface --surface-offset 0.25 --lr 3e-5 --w-surface 0 --w-normal 0"
-  "--w-surface 0 --w-normal 0"
+  "--init surface --surface-offset 0.25 --lr 3e-5 --w-surface 0 --w-normal 0 --no-relabel --no-carve"
+  "--w-surface 0 --w-normal 0 --no-relabel --no-carve"
   "--w-normal 0"
+  "--w-normal 0.1"
   "--surface-offset 0.5"
+  "--no-carve"
+  "--no-relabel --no-carve"
   ""
 )
 echo "| mesh | variant | Hausdorff % | Chamfer L1 % | F-score | normal consistency | misclassified % | seconds |"
