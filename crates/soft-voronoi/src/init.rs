@@ -245,12 +245,20 @@ pub fn pairs_init_refined(
         }
     }
     let labels: Vec<bool> = located.iter().map(|l| l.inside).collect();
+    let mut kept_sites = Vec::with_capacity(k);
+    let mut kept_labels = Vec::with_capacity(k);
+    let columns = thin_columns(data, &chosen, &delta, &labels, solid, r0, offset, k);
+    for column in columns.values().flatten() {
+        kept_sites.extend_from_slice(column);
+        kept_labels.extend(solid.inside(column));
+    }
     // A pair whose sites still share a side (a crease, a hole, a part thinner than δ/8)
     // would put a site of one label among the other's, which grows a spike of crust: keep
     // one of its sites only.
-    let mut kept_sites = Vec::with_capacity(k);
-    let mut kept_labels = Vec::with_capacity(k);
     for i in 0..chosen.len() {
+        if columns.contains_key(&i) {
+            continue;
+        }
         let both = labels[2 * i] != labels[2 * i + 1];
         for j in [2 * i, 2 * i + 1].into_iter().take(if both { 2 } else { 1 }) {
             kept_sites.push(sites[j]);
@@ -258,6 +266,8 @@ pub fn pairs_init_refined(
         }
     }
     let (mut sites, mut labels) = (kept_sites, kept_labels);
+    sites.truncate(k);
+    labels.truncate(k);
     while sites.len() < k {
         // Odd K, too few well-spread points or dropped sites: training samples fill up,
         // with their ground truth.
@@ -266,6 +276,86 @@ pub fn pairs_init_refined(
         labels.push(data.occupancy[i]);
     }
     Ok((sites, labels, r0))
+}
+
+/// Columns across thin parts: where a pair's spacing or δ had to shrink (the part is
+/// thinner than the pair was wide), the part's thickness w along the inward normal at p is
+/// found (doubling, then bisection, of the solid's inside test) and the pair is replaced by
+/// a column: inside at p + (w/2)·u (the middle), outside at its mirror images across both
+/// faces, p − (w/2)·u and p + (3w/2)·u. Each face is then exactly the bisector of the middle
+/// site and its mirror, and as every column carries both, a flat plate comes out flat
+/// whatever the spacing (mirrored pairs from its two faces do not line up, and crumple it).
+/// A column costs 3 sites against a pair's 2, so two thirds of the thin pairs become columns
+/// (the first ones, in the candidates' random order) and the rest are dropped, keeping K.
+/// Returns pair index → its column, or `None` for a dropped pair.
+#[allow(clippy::too_many_arguments)]
+fn thin_columns(
+    data: &TrainingData,
+    chosen: &[u32],
+    delta: &[f64],
+    labels: &[bool],
+    solid: &dyn Solid,
+    r0: f64,
+    offset: f64,
+    k: usize,
+) -> std::collections::BTreeMap<usize, Option<[[f64; 3]; 3]>> {
+    let thin: Vec<usize> =
+        (0..chosen.len()).filter(|&i| labels[2 * i] != labels[2 * i + 1] && delta[i] < 0.99 * offset * r0).collect();
+    // Inward unit normal and the known inside depth of each thin pair.
+    let frame: Vec<([f64; 3], [f64; 3])> = thin
+        .iter()
+        .map(|&i| {
+            let (p, n) = (data.surface[chosen[i] as usize], data.normals[chosen[i] as usize]);
+            let u = if labels[2 * i] { n } else { n.map(|x| -x) };
+            (p, u)
+        })
+        .collect();
+    let at = |j: usize, t: f64| [0, 1, 2].map(|c| (frame[j].0[c] + t * frame[j].1[c]).clamp(1e-6, 1.0 - 1e-6));
+    let mut lo: Vec<f64> = thin.iter().map(|&i| delta[i]).collect();
+    let mut hi: Vec<f64> = lo.iter().map(|&d| 2.0 * d).collect();
+    let mut open: Vec<usize> = (0..thin.len()).collect();
+    let mut bracketed = vec![false; thin.len()];
+    for _ in 0..6 {
+        if open.is_empty() {
+            break;
+        }
+        let probes: Vec<[f64; 3]> = open.iter().map(|&j| at(j, hi[j])).collect();
+        let inside = solid.inside(&probes);
+        let mut still = Vec::new();
+        for (&j, &ins) in open.iter().zip(&inside) {
+            if ins {
+                lo[j] = hi[j];
+                hi[j] *= 2.0;
+                still.push(j);
+            } else {
+                bracketed[j] = true;
+            }
+        }
+        open = still;
+    }
+    let mut which: Vec<usize> = (0..thin.len()).filter(|&j| bracketed[j]).collect();
+    for _ in 0..10 {
+        let probes: Vec<[f64; 3]> = which.iter().map(|&j| at(j, 0.5 * (lo[j] + hi[j]))).collect();
+        for (&j, ins) in which.iter().zip(solid.inside(&probes)) {
+            let mid = 0.5 * (lo[j] + hi[j]);
+            if ins {
+                lo[j] = mid;
+            } else {
+                hi[j] = mid;
+            }
+        }
+    }
+    // Only parts thinner than the pair was meant to be wide become columns.
+    which.retain(|&j| 0.5 * (lo[j] + hi[j]) < 2.0 * offset * r0);
+    let budget = k.saturating_sub(2 * (chosen.len() - which.len())) / 3;
+    which
+        .into_iter()
+        .enumerate()
+        .map(|(n, j)| {
+            let w = 0.5 * (lo[j] + hi[j]);
+            (thin[j], (n < budget).then(|| [at(j, 0.5 * w), at(j, -0.5 * w), at(j, 1.5 * w)]))
+        })
+        .collect()
 }
 
 /// Greedy Poisson-disk subset of `points` (in order) with `target` points: r is bisected
@@ -380,31 +470,45 @@ fn feature_caps(points: &[[f64; 3]], normals: &[[f64; 3]], solid: &dyn Solid, r0
 /// About `target` well-spread points of `points` with their spacing: where `cap` is finite
 /// (thin parts, folds, sharp creases) a Poisson-disk subset at that spacing, one pass per
 /// cap level; elsewhere a Poisson-disk subset at the uniform spacing that makes up the
-/// rest of the count. Thin regions take at most half the budget (their greedy order is
-/// random, so truncation thins them evenly).
+/// rest of the count. Thin regions take at most half the budget unless the rest has too few
+/// candidates (their greedy order is random, so truncation thins them evenly).
 fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], target: usize) -> (Vec<u32>, Vec<f64>) {
     let mut levels: Vec<f64> = cap.iter().copied().filter(|c| c.is_finite()).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
+    // Thin regions take at most half the budget, unless the rest of the surface has too few
+    // candidates to fill the other half (a thin plate is all thin region).
+    let free: Vec<u32> = (0..points.len() as u32).filter(|&i| cap[i as usize].is_infinite()).collect();
+    let keep = (target / 2).max(target.saturating_sub(free.len()));
     let mut chosen = Vec::new();
     let mut spacing = Vec::new();
     for &h in levels.iter().rev() {
         let ids: Vec<u32> = (0..points.len() as u32).filter(|&i| cap[i as usize] == h).collect();
         let pts: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
-        for j in greedy_disk(&pts, h) {
-            chosen.push(ids[j as usize]);
-            spacing.push(h);
+        let got = greedy_disk(&pts, h);
+        let room = keep - chosen.len();
+        if got.len() <= room {
+            for j in got {
+                chosen.push(ids[j as usize]);
+                spacing.push(h);
+            }
+        } else {
+            // More than the allowance at this spacing: spread the allowance evenly over the
+            // level instead (a wider Poisson-disk spacing), rather than cut a random subset.
+            let (even, r) = poisson_subset(&pts, room);
+            for j in even {
+                chosen.push(ids[j as usize]);
+                spacing.push(r.max(h));
+            }
+            break;
         }
     }
-    chosen.truncate(target / 2);
-    spacing.truncate(target / 2);
-    let ids: Vec<u32> = (0..points.len() as u32).filter(|&i| cap[i as usize].is_infinite()).collect();
-    let pts: Vec<[f64; 3]> = ids.iter().map(|&i| points[i as usize]).collect();
+    let pts: Vec<[f64; 3]> = free.iter().map(|&i| points[i as usize]).collect();
     let rest = target - chosen.len();
     if rest > 0 && !pts.is_empty() {
         let (base, r) = poisson_subset(&pts, rest);
         for j in base {
-            chosen.push(ids[j as usize]);
+            chosen.push(free[j as usize]);
             spacing.push(r);
         }
     }
