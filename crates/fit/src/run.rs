@@ -115,7 +115,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     let solid = target.solid();
     timings.sample = lap.next();
     let untrained;
-    let config = if target.initial_sites().is_some() && !config.train_shell {
+    let config = if target.places_sites() && !config.train_shell {
         untrained =
             FitConfig { train: soft_voronoi::TrainConfig { steps: 0, ..config.train.clone() }, ..config.clone() };
         &untrained

@@ -36,6 +36,11 @@ impl Target<'_> {
             Target::Shell(_, sites, labels) => Some((sites.clone(), labels.clone())),
         }
     }
+
+    /// Whether the target places its own sites (then they are not trained by default).
+    pub(crate) fn places_sites(&self) -> bool {
+        matches!(self, Target::Shell(..))
+    }
 }
 
 /// Which solid was fitted and why (report field `solid`).
