@@ -11,9 +11,10 @@ use std::path::PathBuf;
 
 pub type Mesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
-/// Directory of the shared meshes: `$VF_MESHES`, else `../shared/meshes` beside the repo.
+/// Directory of the shared meshes: `$VF_SHARED_MESHES` (the name the rest of the test
+/// suite reads; `$VF_MESHES` is still accepted), else `../shared/meshes` beside the repo.
 pub fn shared_meshes_dir() -> PathBuf {
-    if let Ok(d) = std::env::var("VF_MESHES") {
+    if let Some(d) = std::env::var_os("VF_SHARED_MESHES").or_else(|| std::env::var_os("VF_MESHES")) {
         return PathBuf::from(d);
     }
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/meshes")
