@@ -155,6 +155,55 @@ impl<T: Real> Mlp<T> {
         Ok(Mlp { config, layers, params })
     }
 
+    /// A decoder that starts as the signed distance of a sphere: the geometric
+    /// initialisation of SAL (Atzmon & Lipman, CVPR 2020), so a DeepSDF-style decoder begins
+    /// with a surface instead of a constant. Hidden layers: weights N(0, 2/out), biases 0
+    /// (the input point's columns of a skip layer start at 0); output layer: weights
+    /// `scale`·√π/√in (with a tiny N(0, 1e-6) jitter), bias −`scale`·`radius`. For wide
+    /// ReLU layers the output is then ≈ `scale`·(‖x‖ − `radius`) in the network's
+    /// coordinates (`scale` converts them to the targets' unit; DeepSDF's `tanh` is ≈ the
+    /// identity there). Drawn from `seed` in a fixed order.
+    ///
+    /// # Errors
+    /// An invalid `config`, or a non-finite or non-positive `radius` or `scale`.
+    pub fn new_geometric(config: DecoderConfig, seed: u64, radius: f64, scale: f64) -> Result<Self> {
+        if !(radius.is_finite() && radius > 0.0) {
+            return config_err("radius", radius, "the initial sphere's radius must be finite and positive");
+        }
+        if !(scale.is_finite() && scale > 0.0) {
+            return config_err("scale", scale, "the output scale must be finite and positive");
+        }
+        let mut model = Self::new(config, seed)?;
+        let mut rng = SplitMix64::new(seed, Stream::MlpInit);
+        // Box–Muller from the stream's uniforms (one normal per pair; the order is fixed).
+        let mut normal = move || {
+            let u1 = rng.uniform().max(1e-300);
+            let u2 = rng.uniform();
+            (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+        };
+        let last = model.layers.len() - 1;
+        let skip = model.config.skip;
+        for (l, layer) in model.layers.clone().iter().enumerate() {
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            for i in 0..n_in {
+                for o in 0..n_out {
+                    let v = if l == last {
+                        scale * std::f64::consts::PI.sqrt() / (n_in as f64).sqrt() + 1e-6 * normal()
+                    } else if skip == Some(l) && i >= n_in - 3 {
+                        0.0
+                    } else {
+                        normal() * (2.0 / n_out as f64).sqrt()
+                    };
+                    model.params[layer.w + i * n_out + o] = T::of(v);
+                }
+            }
+            for o in 0..n_out {
+                model.params[layer.b() + o] = T::of(if l == last { -scale * radius } else { 0.0 });
+            }
+        }
+        Ok(model)
+    }
+
     pub fn config(&self) -> &DecoderConfig {
         &self.config
     }

@@ -306,6 +306,7 @@ pub struct Trainer<T: Real> {
     pos: usize,
     rng: SplitMix64,
     step: usize,
+    lr_factor: f64,
 }
 
 impl<T: Real> Trainer<T> {
@@ -326,6 +327,7 @@ impl<T: Real> Trainer<T> {
             pos: 0,
             rng: SplitMix64::new(config.seed, Stream::MlpBatch),
             step: 0,
+            lr_factor: 1.0,
         };
         if batch < n_data {
             t.shuffle();
@@ -339,6 +341,17 @@ impl<T: Real> Trainer<T> {
             self.perm.swap(i, j);
         }
         self.pos = 0;
+    }
+
+    /// Multiplies every later step's learning rate (the schedule's value) by `factor`
+    /// from now on: how a caller reduces the rate when the loss plateaus.
+    pub fn set_lr_factor(&mut self, factor: f64) {
+        self.lr_factor = factor;
+    }
+
+    /// The factor set by [`Trainer::set_lr_factor`] (1 at the start).
+    pub fn lr_factor(&self) -> f64 {
+        self.lr_factor
     }
 
     /// Steps taken so far.
@@ -373,7 +386,7 @@ impl<T: Real> Trainer<T> {
             self.pos += self.batch;
         }
         let loss = self.engine.loss_grad(model, points, targets, idx)?;
-        let lr = self.config.lr_at(self.step);
+        let lr = self.config.lr_at(self.step) * self.lr_factor;
         self.adam.update(&mut model.params, &self.engine.grad, lr);
         let rec = StepRecord { step: self.step, loss, lr, seconds: t0.elapsed().as_secs_f64() };
         self.step += 1;

@@ -36,7 +36,7 @@ pub use error::MetricsError;
 pub use eval::{evaluate, EvalOptions, EvalReport};
 pub use hausdorff::{
     check_mesh, directed_hausdorff_certified, hausdorff_certified, hausdorff_libigl, hausdorff_sphere_certified,
-    CertifiedOptions, DistanceMesh, HausdorffInterval, SphereInterval,
+    hausdorff_sphere_certified_limited, CertifiedOptions, DistanceMesh, HausdorffInterval, SphereInterval,
 };
 pub use iou::{volumetric_iou, IouResult};
 pub use surface::{surface_metrics, SurfaceMetrics, SurfaceOptions};

@@ -3,21 +3,26 @@
 //! decoders of many sizes, and compare the Hausdorff distance to the analytic sphere
 //! against parameter count.
 //!
-//! Every run gets a fixed, documented [`Budget`]. Surfaces: the Voronoi crust (exact,
-//! watertight; [`fit::crust_of`], the main job's) and marching cubes of the decoders on a
-//! grid. Distances: a certified Hausdorff interval to the analytic sphere
-//! ([`metrics::hausdorff_sphere_certified`]) and a sampled Chamfer L1 distance
-//! ([`measure`]). [`run`] returns the [`Row`]s; [`write`] writes results.csv, the plot,
-//! table.md and budget.json atomically.
+//! Fairness: the Voronoi sites are fitted by the main job itself ([`fit::fit`] on a finely
+//! triangulated sphere, default settings); the decoders train until their loss plateaus
+//! ([`plateau`]), DeepSDF from SAL's geometric initialisation; every (method, size) runs
+//! under each of the [`Budget`]'s seeds. Two reference lines: the crust of K sites placed
+//! by construction (mirrored pairs on a Fibonacci lattice, no training) and marching cubes
+//! of the exact signed distance on the decoders' grid. Surfaces: the Voronoi crust (exact,
+//! watertight) and marching cubes of the decoders. Distances: a certified Hausdorff
+//! interval to the analytic sphere ([`metrics::hausdorff_sphere_certified`]) and a sampled
+//! Chamfer L1 distance ([`measure`]). [`run`] returns the [`Row`]s; [`write`] writes
+//! results.csv, summary.csv, the plot, table.md and budget.json atomically.
 
 pub mod budget;
 pub mod data;
 pub mod measure;
+pub mod plateau;
 pub mod runs;
 pub mod write;
 
 pub use budget::Budget;
-pub use runs::{run, Row, StudyProgress};
+pub use runs::{num_units, run, Row, StudyProgress};
 
 /// The study's sphere.
 pub const SPHERE: mesh_io::shapes::Sphere = mesh_io::shapes::Sphere { center: [0.5; 3], radius: 0.35 };

@@ -47,19 +47,32 @@ pub fn sphere_chamfer(mesh: &TriMesh, oracle: &MeshOracle, n: usize, seed: u64) 
     Ok(0.5 * (d1 + d2))
 }
 
-/// Certified Hausdorff interval (tolerance 1e-6 √3), Chamfer, triangle count and
+/// The certified Hausdorff tolerance of the runs (unit cube).
+pub const TOLERANCE: f64 = 1e-6 * 1.732_050_807_568_877_2;
+
+/// The metrics crate's own limit of sphere patches (the runs' intervals converge well before).
+pub const EVALUATIONS: usize = 20_000_000;
+
+/// Certified Hausdorff interval (tolerance `tol`, at most `max_evaluations` patches of the
+/// sphere; the runs use [`TOLERANCE`] and [`EVALUATIONS`]), Chamfer, triangle count and
 /// closedness of a surface; NaN distances for an empty surface.
 ///
 /// # Errors
 /// [`StudyError::Run`] when a distance cannot be computed.
-pub fn measure(mesh: &TriMesh, chamfer_samples: usize, seed: u64) -> Result<Measured, StudyError> {
+pub fn measure(
+    mesh: &TriMesh,
+    chamfer_samples: usize,
+    seed: u64,
+    tol: f64,
+    max_evaluations: usize,
+) -> Result<Measured, StudyError> {
     if mesh.triangles.is_empty() {
         let nan = f64::NAN;
         return Ok(Measured { hausdorff_lo: nan, hausdorff_hi: nan, chamfer: nan, triangles: 0, watertight: false });
     }
     let oracle = MeshOracle::from_mesh(mesh, &occupancy::Config::default())
         .map_err(|e| StudyError::Run(format!("distance oracle: {e}")))?;
-    let h = metrics::hausdorff_sphere_certified(mesh, &SPHERE, 1e-6 * 3f64.sqrt())
+    let h = metrics::hausdorff_sphere_certified_limited(mesh, &SPHERE, tol, max_evaluations)
         .map_err(|e| StudyError::Run(format!("Hausdorff distance: {e}")))?;
     let chamfer = sphere_chamfer(mesh, &oracle, chamfer_samples, seed)?;
     let report = mesh_io::TopologyReport::of(mesh);

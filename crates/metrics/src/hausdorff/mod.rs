@@ -93,7 +93,9 @@ use crate::MetricsError;
 pub(crate) use driver::certify;
 pub use libigl::{hausdorff_libigl, libigl_of};
 pub use mesh::{check_mesh, DistanceMesh};
-pub use sphere::{certify_sphere_prepared, hausdorff_sphere_certified, SphereInterval};
+pub use sphere::{
+    certify_sphere_prepared, hausdorff_sphere_certified, hausdorff_sphere_certified_limited, SphereInterval,
+};
 
 type V3 = [f64; 3];
 

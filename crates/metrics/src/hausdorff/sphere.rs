@@ -10,7 +10,10 @@
 //!   spherical triangle from its centre is a corner), so `d(y, M) ≤ d(s, M) + R` on it;
 //!   `d(s, M)` itself is a lower bound. Patches whose bound exceeds the best lower bound
 //!   by more than `tol` are split, the largest bound first, until none is left (or after
-//!   20,000,000 evaluations; the interval is then valid but wider, and `converged` false).
+//!   20,000,000 evaluations, or the caller's limit; the interval is then valid but wider,
+//!   and `converged` false). A surface about equally far from the sphere everywhere
+//!   (marching cubes of its exact distance) needs patches everywhere as small as `tol`:
+//!   such callers pass a limit ([`hausdorff_sphere_certified_limited`]).
 //!
 //! `d(·, M)` is the exact BVH closest-point distance of [`DistanceMesh`] (the occupancy
 //! crate's, bit-identical to `MeshOracle::closest_point`).
@@ -70,8 +73,23 @@ pub struct SphereInterval {
 /// for a sphere with a non-finite or huge centre or a radius that is not finite and > 0,
 /// and for a `tol` that is NaN or negative.
 pub fn hausdorff_sphere_certified(mesh: &TriMesh, sphere: &Sphere, tol: f64) -> Result<SphereInterval, MetricsError> {
+    hausdorff_sphere_certified_limited(mesh, sphere, tol, MAX_EVALUATIONS)
+}
+
+/// [`hausdorff_sphere_certified`] that stops after `max_evaluations` patches (at most the
+/// default 20,000,000): the interval stays certified, only wider when the limit is hit.
+///
+/// # Errors
+/// As [`hausdorff_sphere_certified`].
+pub fn hausdorff_sphere_certified_limited(
+    mesh: &TriMesh,
+    sphere: &Sphere,
+    tol: f64,
+    max_evaluations: usize,
+) -> Result<SphereInterval, MetricsError> {
     let prepared = DistanceMesh::new(mesh, "mesh")?;
-    certify_sphere_prepared(&prepared, sphere, tol)
+    check_sphere(sphere, tol)?;
+    Ok(certify(&prepared, sphere, tol, max_evaluations.min(MAX_EVALUATIONS)))
 }
 
 /// [`hausdorff_sphere_certified`] on a prepared mesh.
@@ -80,12 +98,16 @@ pub fn hausdorff_sphere_certified(mesh: &TriMesh, sphere: &Sphere, tol: f64) -> 
 /// [`MetricsError::BadOption`], as [`hausdorff_sphere_certified`].
 pub fn certify_sphere_prepared(mesh: &DistanceMesh, sphere: &Sphere, tol: f64) -> Result<SphereInterval, MetricsError> {
     check_sphere(sphere, tol)?;
+    Ok(certify(mesh, sphere, tol, MAX_EVALUATIONS))
+}
+
+fn certify(mesh: &DistanceMesh, sphere: &Sphere, tol: f64, max_evaluations: usize) -> SphereInterval {
     let mesh_to_sphere = mesh_to_sphere(mesh.mesh(), sphere);
-    let (lo2, hi2, evaluations, converged) = sphere_to_mesh(mesh, sphere, tol);
+    let (lo2, hi2, evaluations, converged) = sphere_to_mesh(mesh, sphere, tol, max_evaluations);
     let margin = rounding_margin(mesh.mesh(), sphere);
     let lo = mesh_to_sphere.max(lo2) - margin;
     let hi = mesh_to_sphere.max(hi2) + margin;
-    Ok(SphereInterval {
+    SphereInterval {
         lo: lo.max(0.0),
         hi,
         mesh_to_sphere,
@@ -94,7 +116,7 @@ pub fn certify_sphere_prepared(mesh: &DistanceMesh, sphere: &Sphere, tol: f64) -
         rounding_margin: margin,
         converged,
         patches_evaluated: evaluations,
-    })
+    }
 }
 
 fn check_sphere(sphere: &Sphere, tol: f64) -> Result<(), MetricsError> {
@@ -174,19 +196,42 @@ fn norm(a: V3, b: V3) -> f64 {
 }
 
 /// Lower and upper bound of `d(·, mesh)` on a patch: the distance at its centre's point,
-/// plus the patch's radius around it.
+/// and the least of two upper bounds. (1) Lipschitz: that distance plus the patch's radius
+/// around it. (2) One triangle: the patch lies in the convex hull H of its corners'
+/// points `c + r·aᵢ` and the same scaled by 1/m about the centre c (m: the distance from
+/// the origin to the flat triangle of the unit corners aᵢ; every patch point is
+/// `c + r·v/‖v‖` with v on that flat triangle, so ‖v‖ ≥ m), and the distance to the
+/// triangle T nearest the centre's point is convex, so its maximum over H, reached at one
+/// of H's six vertices, bounds `d(·, mesh) ≤ d(·, T)` on the patch. Bound (2) is tight
+/// for a patch within one triangle's reach, so the search only needs small patches along
+/// the mesh's edges, not everywhere (a surface about equally far from the sphere all over,
+/// like marching cubes of its distance, would otherwise need patches as small as the
+/// tolerance everywhere).
 fn eval_patch(mesh: &DistanceMesh, sphere: &Sphere, corners: &[V3; 3], ws: &mut Workspace) -> (f64, f64) {
     let s = normalize([0, 1, 2].map(|k| corners[0][k] + corners[1][k] + corners[2][k]));
     let on_sphere = [0, 1, 2].map(|k| sphere.center[k] + sphere.radius * s[k]);
-    let d = mesh.bvh().closest_point(on_sphere, ws).squared_distance.sqrt();
+    let closest = mesh.bvh().closest_point(on_sphere, ws);
+    let d = closest.squared_distance.sqrt();
     let r = corners.iter().map(|&a| norm(s, a)).fold(0.0, f64::max) * sphere.radius;
-    (d, d + r)
+    let m = norm(closest_point_triangle([0.0; 3], corners[0], corners[1], corners[2]), [0.0; 3]);
+    let mut one_triangle = f64::INFINITY;
+    if m > 0.5 {
+        let [ta, tb, tc] = mesh.corners(closest.triangle);
+        one_triangle = 0.0;
+        for scale in [sphere.radius, sphere.radius / m] {
+            for a in corners {
+                let p = [0, 1, 2].map(|k| sphere.center[k] + scale * a[k]);
+                one_triangle = one_triangle.max(norm(p, closest_point_triangle(p, ta, tb, tc)));
+            }
+        }
+    }
+    (d, (d + r).min(one_triangle))
 }
 
 /// `h(sphere → mesh)` by best-first branch and bound (see the module doc): the largest
 /// evaluated distance, the upper bound, the patches evaluated and whether the search
 /// finished. Sequential: one workspace, so its closest-point hints are deterministic.
-fn sphere_to_mesh(mesh: &DistanceMesh, sphere: &Sphere, tol: f64) -> (f64, f64, u64, bool) {
+fn sphere_to_mesh(mesh: &DistanceMesh, sphere: &Sphere, tol: f64, max_evaluations: usize) -> (f64, f64, u64, bool) {
     // The starting patches: the icosahedron's faces (unit vectors, counter-clockwise).
     let icosahedron = mesh_io::shapes::icosphere(0);
     let mut ws = Workspace::new();
@@ -200,7 +245,7 @@ fn sphere_to_mesh(mesh: &DistanceMesh, sphere: &Sphere, tol: f64) -> (f64, f64, 
     }
     let mut evaluations = 0usize;
     while let Some(top) = heap.peek() {
-        if top.ub <= lo2 + tol || evaluations > MAX_EVALUATIONS {
+        if top.ub <= lo2 + tol || evaluations > max_evaluations {
             break;
         }
         let Some(p) = heap.pop() else { break };
