@@ -11,9 +11,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
-use fit::{Checkpointing, FitConfig, FitError, Progress, SolidRule, DEFAULT_SITES};
+use fit::{Checkpointing, FitConfig, FitError, FitOptions, Progress, SolidRule};
 use mesh_io::OutputFormat;
-use soft_voronoi::{Init, StepStats, TrainConfig};
+use soft_voronoi::{Init, StepStats};
 
 use crate::cli_error::CliError;
 
@@ -185,43 +185,39 @@ fn outputs(args: &Args) -> Result<Outputs, CliError> {
     Ok(Outputs { sites: with(".sites.npz"), report: with(".report.json"), checkpoint: with(".ckpt.npz"), mesh })
 }
 
-/// Raw flags → the validated fit settings.
+/// Raw flags → the validated fit settings (through [`fit::FitOptions`], as the Python
+/// package does).
 fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
-    let mut c = FitConfig::new(&args.mesh.display().to_string(), args.sites.unwrap_or(DEFAULT_SITES));
-    c.sampling.samples = args.samples;
-    c.sampling.solid = args.solid;
-    c.sampling.shell_thickness = args.shell_thickness;
-    c.train_shell = args.steps.is_some();
-    // The paper preset is the paper's method: no relabelling, no insertion.
-    let paper = args.preset == "paper";
-    c.relabel = !args.no_relabel && !paper;
-    c.carve = if args.no_carve || (paper && args.carve.is_none()) { None } else { args.carve.or(c.carve) };
-    c.eval.samples = args.eval_samples;
+    let options = FitOptions {
+        sites: args.sites,
+        steps: args.steps,
+        seed: args.seed,
+        preset: Some(args.preset.clone()),
+        init: args.init,
+        batch: args.batch,
+        lr: args.lr,
+        beta_start: args.beta_start,
+        surface_offset: args.surface_offset,
+        w_sdf: args.w_sdf,
+        w_centroidal: args.w_centroidal,
+        w_normal: args.w_normal,
+        w_reconstruction: args.w_reconstruction,
+        w_surface: args.w_surface,
+        samples: Some(args.samples),
+        eval_samples: Some(args.eval_samples),
+        solid: args.solid,
+        shell_thickness: args.shell_thickness,
+        no_relabel: args.no_relabel,
+        carve: args.carve,
+        no_carve: args.no_carve,
+        skip_metrics: false,
+    };
+    let mut c = options.to_config(&args.mesh.display().to_string())?;
     c.checkpointing = Some(Checkpointing { path: out.checkpoint.clone(), every: args.checkpoint_every });
-    c.preset = args.preset.clone();
     c.output_precision = crust::output::Precision::of_path(&out.mesh)?;
     if let Some(p) = &args.resume {
         return Ok(c.resume(p)?);
     }
-    let k = c.train.num_sites;
-    let mut t = if args.preset == "paper" { TrainConfig::paper(k) } else { TrainConfig::default_for(k) };
-    t.steps = args.steps.unwrap_or(t.steps);
-    t.init = args.init.unwrap_or(t.init);
-    t.batch = args.batch.unwrap_or(t.batch);
-    if let Some(lr) = args.lr {
-        t.lr_final = if args.preset == "paper" { lr } else { lr * (t.lr_final / t.lr) };
-        t.lr = lr;
-    }
-    t.beta_start = args.beta_start.or(t.beta_start);
-    t.surface_offset = args.surface_offset.unwrap_or(t.surface_offset);
-    t.weights.signed_distance = args.w_sdf.unwrap_or(t.weights.signed_distance);
-    t.weights.centroidal = args.w_centroidal.unwrap_or(t.weights.centroidal);
-    t.weights.surface = args.w_surface.unwrap_or(t.weights.surface);
-    t.weights.reconstruction = args.w_reconstruction.unwrap_or(t.weights.reconstruction);
-    t.weights.normal = args.w_normal.unwrap_or(t.weights.normal);
-    c.train = t;
-    let c = c.with_seed(args.seed);
-    c.validate()?;
     Ok(c)
 }
 
@@ -265,7 +261,6 @@ fn read_input(args: &Args) -> Result<mesh_io::TriMesh, CliError> {
 }
 
 pub fn run(args: Args) -> Result<(), CliError> {
-    let t_all = Instant::now();
     // Ctrl-C sets a flag; training checks it after every step and stops with a checkpoint.
     // Installed first, so an early Ctrl-C also ends cleanly at the first step.
     let interrupted = Arc::new(AtomicBool::new(false));
@@ -273,14 +268,55 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let flag = interrupted.clone();
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
-    let out = outputs(&args)?;
-    let config = config_from_args(&args, &out)?;
-    let input = read_input(&args)?;
+    let bar = if args.quiet || args.json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(0) };
+    let done = fit_to_files(&args, interrupted, bar)?;
+    if args.json {
+        crate::output::out!("{}", done.json);
+    } else {
+        crate::output::out!(
+            "{} Wrote {}, {}, {} and {} in {:.1} s.",
+            done.report.summary(),
+            done.out.mesh.display(),
+            done.out.sites.display(),
+            done.picture.display(),
+            done.out.report.display(),
+            done.report.total_seconds
+        );
+        if let Some(page) = &done.page {
+            crate::output::out!("Wrote the viewer page {} (open it in a browser; it works offline).", page.display());
+        }
+    }
+    Ok(())
+}
+
+/// What [`fit_to_files`] wrote.
+pub struct Written {
+    out: Outputs,
+    /// The report as written.
+    pub report: fit::FitReport,
+    /// The report's JSON text.
+    pub json: String,
+    picture: PathBuf,
+    page: Option<PathBuf>,
+}
+
+/// The main job for one mesh, from parsed arguments to the files on disk (crust, sites,
+/// picture, report, optional page), printing nothing: `voronoi-fit MESH` and each mesh of
+/// `voronoi-fit batch`. Training stops with a checkpoint when `interrupted` is set;
+/// `bar` shows the training steps (hidden for no bar).
+pub fn fit_to_files(
+    args: &Args,
+    interrupted: Arc<AtomicBool>,
+    bar: indicatif::ProgressBar,
+) -> Result<Written, CliError> {
+    let t_all = Instant::now();
+    let out = outputs(args)?;
+    let config = config_from_args(args, &out)?;
+    let input = read_input(args)?;
     if OutputFormat::from_path(&out.mesh)?.stores_f32() {
         // The crust is written in the input's frame; refuse now if float32 cannot resolve it.
         mesh_io::check_f32_resolution(&input, &args.mesh)?;
     }
-    let bar = if args.quiet || args.json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(0) };
     bar.set_style(
         indicatif::ProgressStyle::with_template("train {bar:30} {pos}/{len} steps, loss {msg}, {elapsed} (ETA {eta})")
             .map_err(anyhow::Error::from)?,
@@ -305,26 +341,27 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
         r => r?,
     };
-    write_outputs(&out, result, &args, t_all)
+    write_outputs(out, result, args, t_all)
 }
 
-/// Sites file, crust and report, each atomically; then the summary (or the JSON).
-fn write_outputs(out: &Outputs, mut result: fit::FitOutput, args: &Args, t_all: Instant) -> Result<(), CliError> {
+/// Sites file, crust and report, each atomically (the report last: its presence means the
+/// run finished), and the optional page.
+fn write_outputs(out: Outputs, result: fit::FitOutput, args: &Args, t_all: Instant) -> Result<Written, CliError> {
     result.sites.write(&out.sites)?;
     mesh_io::write_mesh(&out.mesh, &result.crust)?;
     // OUT.png: input and crust side by side from three views (the input is read again, as
     // only the result reaches this function; reading is cheap next to the fit).
     let picture = crate::cmd_view::picture_path(&out.mesh);
     crate::cmd_view::write_picture(&picture, &read_input(args)?, &result.crust, &args.mesh, &result.report)?;
-    let report = &mut result.report;
+    let mut report = result.report;
     report.outputs = fit::report::OutputsReport {
         crust: out.mesh.display().to_string(),
         sites: out.sites.display().to_string(),
         report: out.report.display().to_string(),
     };
     report.total_seconds = t_all.elapsed().as_secs_f64();
-    let text = serde_json::to_string_pretty(&report).map_err(anyhow::Error::from)?;
-    mesh_io::atomic_write(&out.report, |w| w.write_all(text.as_bytes()))?;
+    let json = serde_json::to_string_pretty(&report).map_err(anyhow::Error::from)?;
+    mesh_io::atomic_write(&out.report, |w| w.write_all(json.as_bytes()))?;
     if !args.keep_checkpoint && out.checkpoint.exists() {
         let _ = std::fs::remove_file(&out.checkpoint);
     }
@@ -334,21 +371,5 @@ fn write_outputs(out: &Outputs, mut result: fit::FitOutput, args: &Args, t_all: 
     } else {
         None
     };
-    if args.json {
-        crate::output::out!("{text}");
-    } else {
-        crate::output::out!(
-            "{} Wrote {}, {}, {} and {} in {:.1} s.",
-            report.summary(),
-            out.mesh.display(),
-            out.sites.display(),
-            picture.display(),
-            out.report.display(),
-            report.total_seconds
-        );
-        if let Some(page) = &page {
-            crate::output::out!("Wrote the viewer page {} (open it in a browser; it works offline).", page.display());
-        }
-    }
-    Ok(())
+    Ok(Written { out, report, json, picture, page })
 }

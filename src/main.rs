@@ -5,6 +5,7 @@
 
 mod arrays;
 mod cli_error;
+mod cmd_batch;
 mod cmd_convert;
 mod cmd_crust;
 mod cmd_delaunay;
@@ -46,6 +47,9 @@ enum Command {
     /// The sphere study: Voronoi sites against OccNet / DeepSDF MLPs, Hausdorff distance
     /// against parameter count (results.csv, plot, table.md).
     Study(cmd_study::Args),
+    /// The main job on many meshes: one folder per mesh and summary.csv; a rerun skips what
+    /// finished, resumes what stopped and retries what failed.
+    Batch(cmd_batch::Args),
     /// Print the topology report of a mesh (counts, boundary, manifoldness, genus, volume).
     Info(cmd_info::Args),
     /// Convert a mesh to GLB, glTF, OBJ or PLY (optionally normalised into the unit cube).
@@ -87,6 +91,7 @@ fn main() {
     let result: Result<(), CliError> = match command {
         Command::Fit(args) => cmd_fit::run(args),
         Command::Study(args) => cmd_study::run(args),
+        Command::Batch(args) => cmd_batch::run(args),
         Command::Info(args) => cmd_info::run(args),
         Command::Convert(args) => cmd_convert::run(args),
         Command::Sample(args) => cmd_sample::run(args),

@@ -8,7 +8,8 @@
 #      target/node, and Debian's chromium + chromium-driver (apt-get, when absent) for the
 #      viewer page test;
 #   3. cargo test --workspace in the `ci` profile (release speed with debug assertions);
-#   4. the Python reference checks in tests/reference against the built binary.
+#   4. the Python package (crates/python) built with maturin and installed into the venv;
+#   5. the Python reference checks in tests/reference against the built binary and package.
 #
 # Any failed step fails the run. The last line is `N passed, N failed`.
 set -uo pipefail
@@ -71,6 +72,18 @@ cargo_rc=${PIPESTATUS[0]}
 read -r cp cf < <(awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($(i+1) ~ /^passed/) p += $i; if ($(i+1) ~ /^failed/) f += $i } } END { print p+0, f+0 }' "$LOG/cargo.log")
 passed=$((passed + cp)); failed=$((failed + cf))
 if [ "$cargo_rc" -ne 0 ] && [ "$cf" -eq 0 ]; then step_failed+=("cargo test (exit $cargo_rc)"); fi
+
+note "Python package (maturin build --profile ci, installed into $VENV)"
+# The wheel the README's one-line install builds, here in the ci profile so it reuses the
+# crates cargo test just built; tests/reference/test_python.py imports it.
+rm -rf "$TARGET/wheels"
+if "$VENV/bin/maturin" build --profile ci -m crates/python/Cargo.toml --out "$TARGET/wheels" -i "$VENV/bin/python" > "$LOG/maturin.log" 2>&1 \
+   && "$VENV/bin/pip" install -q --disable-pip-version-check --force-reinstall --no-deps "$TARGET"/wheels/voronoi_fit-*.whl >> "$LOG/maturin.log" 2>&1; then
+  tail -n 1 "$LOG/maturin.log"
+else
+  tail -n 20 "$LOG/maturin.log"
+  step_failed+=("python package build")
+fi
 
 note "Python reference checks (pytest tests/reference)"
 export VF_BIN=$TARGET/ci/voronoi-fit

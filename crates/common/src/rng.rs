@@ -28,6 +28,10 @@ pub enum Stream {
     TrainBatch = 102,
     /// soft-voronoi: the surface-term batches.
     SurfaceBatch = 103,
+    /// soft-voronoi: the fixed evaluation batch that picks the best iterate.
+    SelectionBatch = 104,
+    /// soft-voronoi: the surface samples of that batch.
+    SelectionSurface = 105,
     /// study: the sphere's training data.
     StudySphereData = 301,
     /// study: the sphere's Chamfer samples.
@@ -197,6 +201,8 @@ mod tests {
             SitesInit,
             TrainBatch,
             SurfaceBatch,
+            SelectionBatch,
+            SelectionSurface,
             StudySphereData,
             StudyChamfer,
             MlpBatch,

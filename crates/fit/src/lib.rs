@@ -27,6 +27,7 @@ pub mod crust_step;
 pub mod data;
 pub mod error;
 pub mod grow;
+pub mod options;
 pub mod progress;
 pub mod report;
 mod run;
@@ -36,6 +37,7 @@ pub use config::{Checkpointing, EvalSampling, FitConfig, Sampling, SolidRule, DE
 pub use crust_step::{crust_of, CheckedCrust};
 pub use error::FitError;
 pub use grow::{fit_to_accuracy, AccuracyGoal};
+pub use options::FitOptions;
 pub use progress::{NoProgress, Progress, Stage};
 pub use report::FitReport;
 pub use run::{fit, FitOutput};

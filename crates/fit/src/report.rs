@@ -86,6 +86,20 @@ pub struct LossesReport {
     /// The last step.
     #[serde(rename = "final")]
     pub last: Option<StepStats>,
+    /// The iterate the crust was built from when the best one was kept
+    /// (`TrainConfig::select_every` > 0): steps done when it was measured (0 = the
+    /// initialisation) and its total loss on the fixed evaluation batch; absent when the
+    /// last iterate is used.
+    pub selected: Option<SelectedIterate>,
+}
+
+/// See [`LossesReport::selected`].
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct SelectedIterate {
+    /// Steps done when it was measured.
+    pub step: usize,
+    /// Its total loss on the evaluation batch.
+    pub loss: f64,
 }
 
 impl LossesReport {
@@ -99,7 +113,8 @@ impl LossesReport {
             .filter(|(i, _)| i % every == 0 || *i + 1 == h.len())
             .map(|(_, s)| s.to_row())
             .collect();
-        LossesReport { columns: StepStats::NAMES, every, rows, last: h.last().copied() }
+        let selected = state.best.as_ref().map(|b| SelectedIterate { step: b.step, loss: b.loss });
+        LossesReport { columns: StepStats::NAMES, every, rows, last: h.last().copied(), selected }
     }
 }
 
@@ -286,7 +301,7 @@ impl FitReport {
             None => String::new(),
         };
         format!(
-            "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps; on {} fresh samples {:.3}% are \
+            "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
              misclassified ({:.3}% of uniform, {:.3}% of near-surface ones).{} Crust: {} triangles, {} component(s), \
              genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{} {}{}",
             self.input.path,
@@ -294,6 +309,11 @@ impl FitReport {
             inside_trainable,
             c.num_sites - t.num_sites - inserted,
             t.steps,
+            match &self.losses.selected {
+                Some(b) if b.step < t.steps =>
+                    format!(" (the best iterate by the evaluation batch's loss is kept: step {})", b.step),
+                _ => String::new(),
+            },
             self.settings.eval_samples,
             100.0 * q.misclassification,
             100.0 * q.misclassification_uniform,

@@ -14,6 +14,7 @@
 //! | `located_inside`, `located_closest` | (K,) uint8, (K, 3) float64 | sides and closest surface points at the last refresh |
 //! | `history` | (steps, 10) float64 (9 in checkpoints written before the surface term) | per-step statistics ([`StepStats::NAMES`](crate::StepStats::NAMES)) |
 //! | `data_fingerprint` | (1,) uint64 | fingerprint of the training samples |
+//! | `best_step`, `best_loss`, `best_sites` | (1,) uint64, (1,) float64, (K, 3) float64 | the best iterate so far ([`TrainConfig::select_every`](crate::TrainConfig::select_every)); absent when there is none (and in older checkpoints) |
 //!
 //! f64 values are stored bit for bit, so a resumed run repeats the uninterrupted one
 //! exactly.
@@ -27,7 +28,7 @@ use vf_common::npz::NpzOut;
 
 use crate::error::TrainError;
 use crate::losses::{Located, SiteGraph};
-use crate::train::{StepStats, TrainState};
+use crate::train::{BestIterate, StepStats, TrainState};
 
 /// The checkpoint format version.
 pub const FORMAT_VERSION: i64 = 1;
@@ -59,6 +60,12 @@ pub fn write(path: &Path, state: &TrainState, context_json: &str) -> Result<(), 
         .and_then(|w| w.add("history", &hist))
         .and_then(|w| w.add_vec("data_fingerprint", vec![state.data_fingerprint]))
         .map_err(|e| fail(e.to_string()))?;
+    if let Some(b) = &state.best {
+        w.add_vec("best_step", vec![b.step as u64])
+            .and_then(|w| w.add_vec("best_loss", vec![b.loss]))
+            .and_then(|w| w.add_rows("best_sites", &b.sites))
+            .map_err(|e| fail(e.to_string()))?;
+    }
     w.write(path).map_err(|e| fail(e.to_string()))
 }
 
@@ -124,6 +131,18 @@ pub fn read(path: &Path) -> Result<(TrainState, String), TrainError> {
     if !sites.iter().chain(&m).chain(&v).flatten().all(|x| x.is_finite()) {
         return Err(fail("non-finite sites or Adam moments".into()));
     }
+    let best =
+        if npz.names().map_err(|e| fail(e.to_string()))?.iter().any(|n| n.trim_end_matches(".npy") == "best_step") {
+            let best_step = arr1!("best_step", u64);
+            let best_loss = arr1!("best_loss", f64);
+            let best_sites = arr2!("best_sites");
+            if best_step.len() != 1 || best_loss.len() != 1 || !best_sites.iter().flatten().all(|x| x.is_finite()) {
+                return Err(fail("arrays 'best_*' have the wrong length or non-finite values".into()));
+            }
+            Some(BestIterate { step: best_step[0] as usize, loss: best_loss[0], sites: best_sites })
+        } else {
+            None
+        };
     let located = inside.iter().zip(closest).map(|(&i, c)| Located { inside: i != 0, closest: c }).collect();
     let state = TrainState {
         config,
@@ -136,6 +155,7 @@ pub fn read(path: &Path) -> Result<(TrainState, String), TrainError> {
         located,
         history,
         data_fingerprint: fp[0],
+        best,
     };
     Ok((state, context))
 }

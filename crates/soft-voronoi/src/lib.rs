@@ -28,5 +28,5 @@ pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};
 pub use solid::{MeshSolid, ShellSolid, Sphere};
-pub use train::{classify, soft_values, StepStats, TrainState, Trainer, TrainingData};
+pub use train::{classify, soft_values, BestIterate, StepStats, TrainState, Trainer, TrainingData};
 pub use vf_common::AdamParams;

@@ -109,6 +109,55 @@ pub struct TrainState {
     pub history: Vec<StepStats>,
     /// [`TrainingData::fingerprint`] of the data.
     pub data_fingerprint: u64,
+    /// The best iterate so far by the fixed evaluation batch (`config.select_every` > 0).
+    pub best: Option<BestIterate>,
+}
+
+/// The iterate with the lowest total loss on the fixed evaluation batch
+/// ([`TrainConfig::select_every`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BestIterate {
+    /// Steps done when it was measured (0 = the initialisation).
+    pub step: usize,
+    /// Its total loss on the evaluation batch.
+    pub loss: f64,
+    /// Its K trainable sites (the boundary sites never move).
+    pub sites: Vec<[f64; 3]>,
+}
+
+/// The fixed evaluation batch of [`TrainConfig::select_every`]: drawn once from the data
+/// with its own streams, so a resumed run rebuilds the same one.
+struct SelectionBatch {
+    points: Vec<[f64; 3]>,
+    occupancy: Vec<bool>,
+    surface: Vec<[f64; 3]>,
+    normals: Vec<[f64; 3]>,
+}
+
+impl SelectionBatch {
+    fn draw(config: &TrainConfig, data: &TrainingData) -> Option<Self> {
+        if config.select_every == 0 {
+            return None;
+        }
+        let n = config.selection_batch;
+        let mut rng = ChunkRng::for_chunk(config.seed, Stream::SelectionBatch, 0);
+        let (mut points, mut occupancy) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        for _ in 0..n {
+            let i = (rng.next_u64() % data.points.len() as u64) as usize;
+            points.push(data.points[i]);
+            occupancy.push(data.occupancy[i]);
+        }
+        let (mut surface, mut normals) = (Vec::new(), Vec::new());
+        if !data.surface.is_empty() {
+            let mut rng = ChunkRng::for_chunk(config.seed, Stream::SelectionSurface, 0);
+            for _ in 0..n {
+                let i = (rng.next_u64() % data.surface.len() as u64) as usize;
+                surface.push(data.surface[i]);
+                normals.push(data.normals.get(i).copied().unwrap_or([0.0; 3]));
+            }
+        }
+        Some(SelectionBatch { points, occupancy, surface, normals })
+    }
 }
 
 /// A training run over borrowed data and solid.
@@ -121,6 +170,7 @@ pub struct Trainer<'a> {
     batch_occupancy: Vec<bool>,
     surface_points: Vec<[f64; 3]>,
     surface_normals: Vec<[f64; 3]>,
+    selection: Option<SelectionBatch>,
 }
 
 impl<'a> Trainer<'a> {
@@ -183,6 +233,7 @@ impl<'a> Trainer<'a> {
             located: Vec::new(),
             history: Vec::new(),
             data_fingerprint: data.fingerprint(),
+            best: None,
             sites,
             labels,
             config,
@@ -219,6 +270,7 @@ impl<'a> Trainer<'a> {
             || state.step > state.config.steps
             || (state.step > 0 && state.config.weights.signed_distance > 0.0 && state.located.len() != k)
             || (state.step > 0 && state.config.weights.centroidal > 0.0 && state.graph.num_sites() != state.sites.len())
+            || state.best.as_ref().is_some_and(|b| b.sites.len() != k || b.step > state.step)
         {
             return fail("its arrays are inconsistent with its settings".into());
         }
@@ -229,7 +281,6 @@ impl<'a> Trainer<'a> {
         let k = state.config.num_sites;
         let b = state.config.batch;
         Trainer {
-            state,
             data,
             solid,
             grad: vec![[0.0; 3]; k],
@@ -237,6 +288,61 @@ impl<'a> Trainer<'a> {
             batch_occupancy: Vec::with_capacity(b),
             surface_points: Vec::new(),
             surface_normals: Vec::new(),
+            selection: SelectionBatch::draw(&state.config, data),
+            state,
+        }
+    }
+
+    /// The total loss of the current sites on the fixed evaluation batch, at the final β
+    /// (so iterates are compared on one scale whatever the annealing), without touching
+    /// the optimiser. Centroidal and signed-distance terms use the state's last refresh.
+    fn selection_loss(&self, batch: &SelectionBatch) -> f64 {
+        let st = &self.state;
+        let cfg = &st.config;
+        let k = cfg.num_sites;
+        let w = &cfg.weights;
+        let kernel = Kernel { beta: cfg.beta, tau: cfg.tau };
+        let mut grad = vec![[0.0; 3]; k];
+        let index = SiteIndex::new(&st.sites);
+        let rec = losses::reconstruction(
+            &kernel,
+            &index,
+            &st.sites,
+            &st.labels,
+            &batch.points,
+            &batch.occupancy,
+            w.reconstruction,
+            &mut grad,
+        );
+        let bnd = losses::bounds(&st.sites[..k], w.bounds, &mut grad);
+        let sdf = if w.signed_distance > 0.0 && st.located.len() == k {
+            losses::signed_distance_cached(&st.located, &st.sites[..k], &st.labels[..k], w.signed_distance, &mut grad)
+        } else {
+            0.0
+        };
+        let cen = if w.centroidal > 0.0 && st.graph.num_sites() == st.sites.len() {
+            losses::centroidal(&st.graph, &st.sites, w.centroidal, &mut grad)
+        } else {
+            0.0
+        };
+        let srf = if w.surface > 0.0 && !batch.surface.is_empty() {
+            let labelled = losses::LabelledIndex::new(&st.sites, &st.labels);
+            losses::surface(&labelled, &st.sites, &batch.surface, &batch.normals, w.normal, w.surface, &mut grad)
+        } else {
+            0.0
+        };
+        w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen + w.surface * srf
+    }
+
+    /// Measures the current sites on the evaluation batch and keeps them if they are the
+    /// best so far (ties keep the earlier iterate).
+    fn consider_current(&mut self) {
+        let Some(batch) = &self.selection else { return };
+        let loss = self.selection_loss(batch);
+        let st = &mut self.state;
+        if loss.is_finite() && st.best.as_ref().is_none_or(|b| loss < b.loss) {
+            let k = st.config.num_sites;
+            st.best = Some(BestIterate { step: st.step, loss, sites: st.sites[..k].to_vec() });
         }
     }
 
@@ -261,6 +367,18 @@ impl<'a> Trainer<'a> {
     /// # Errors
     /// [`TrainError::Diverged`] on a non-finite loss or site; Delaunay failures.
     pub fn step(&mut self) -> Result<StepStats, TrainError> {
+        let every = self.state.config.select_every;
+        if every > 0 && self.state.step % every == 0 {
+            self.consider_current();
+        }
+        let stats = self.update()?;
+        if self.is_done() {
+            self.consider_current();
+        }
+        Ok(stats)
+    }
+
+    fn update(&mut self) -> Result<StepStats, TrainError> {
         let st = &mut self.state;
         let cfg = &st.config;
         let t = st.step;
@@ -367,11 +485,20 @@ impl<'a> Trainer<'a> {
         Ok(stats)
     }
 
-    /// The sites for the crust: all sites (trainable then boundary), projected into
-    /// [ε, 1 − ε]³ with ε = 1e-9 (the crust needs them strictly inside the unit cube),
-    /// their labels, and how many sites the projection moved.
+    /// The sites for the crust: all sites (trainable then boundary) — the best iterate's
+    /// trainable sites when [`TrainConfig::select_every`] is on, else the last — projected
+    /// into [ε, 1 − ε]³ with ε = 1e-9 (the crust needs them strictly inside the unit
+    /// cube), their labels, and how many sites the projection moved.
     pub fn final_sites(&self) -> (Vec<[f64; 3]>, Vec<bool>, usize) {
-        project_sites(&self.state.sites, &self.state.labels)
+        let st = &self.state;
+        match &st.best {
+            Some(b) => {
+                let mut sites = b.sites.clone();
+                sites.extend_from_slice(&st.sites[b.sites.len()..]);
+                project_sites(&sites, &st.labels)
+            }
+            None => project_sites(&st.sites, &st.labels),
+        }
     }
 }
 

@@ -239,3 +239,52 @@ fn invalid_settings_are_refused_with_their_name() {
     let located = SPHERE.locate(&[[0.5, 0.5, 0.9]]);
     assert!(!located[0].inside);
 }
+
+/// The best iterate by the fixed evaluation batch is what `final_sites` returns; measuring
+/// it does not change the trajectory; with selection off the last iterate is returned.
+#[test]
+fn the_best_iterate_is_kept_and_does_not_change_the_run() {
+    let data = sphere_data(40_000, 7);
+    // Mirrored pairs start close to the sphere; a constant learning rate far too large for
+    // them (5e-3, a quarter of their spacing per step) makes the loss worse, so the
+    // initialisation must be the best iterate.
+    let mut c = TrainConfig::default_for(512);
+    c.steps = 30;
+    c.batch = 4096;
+    c.lr = 5e-3;
+    c.lr_final = 5e-3;
+    c.select_every = 5;
+    c.selection_batch = 20_000;
+    c.seed = 4;
+    let mut t = Trainer::new(c.clone(), &data, &SPHERE).unwrap();
+    let init = t.state().sites.clone();
+    while !t.is_done() {
+        t.step().unwrap();
+    }
+    let best = t.state().best.clone().expect("a best iterate");
+    assert_eq!(best.step, 0, "a run that only got worse kept step {}", best.step);
+    let (sites, _, _) = t.final_sites();
+    assert_eq!(bits(&sites[..512]), bits(&init[..512]));
+    assert_ne!(bits(&t.state().sites[..512]), bits(&init[..512]));
+
+    // A sound rate: the kept iterate is a later one, and it is the sites that a run without
+    // selection has after that many steps (selection only watches).
+    let mut good = c.clone();
+    good.lr = 1e-4;
+    good.lr_final = 1e-6;
+    good.init = Init::Surface;
+    let mut t = Trainer::new(good.clone(), &data, &SPHERE).unwrap();
+    while !t.is_done() {
+        t.step().unwrap();
+    }
+    let best = t.state().best.clone().unwrap();
+    assert!(best.step > 0 && (best.step % 5 == 0 || best.step == 30), "kept step {}", best.step);
+    let plain = run(TrainConfig { select_every: 0, ..good.clone() }, &data, best.step);
+    assert!(plain.best.is_none());
+    assert_eq!(bits(&best.sites), bits(&plain.sites[..512]));
+    let (sites, _, _) = t.final_sites();
+    assert_eq!(bits(&sites[..512]), bits(&best.sites));
+    let full_plain = run(TrainConfig { select_every: 0, ..good }, &data, 30);
+    let (last, _, _) = Trainer::resume(full_plain.clone(), &data, &SPHERE, "-").unwrap().final_sites();
+    assert_eq!(bits(&last), bits(&full_plain.sites), "selection off: the last iterate");
+}

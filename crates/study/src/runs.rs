@@ -44,8 +44,9 @@ pub struct Row {
     /// Last training loss (the Voronoi fits: the total loss).
     pub final_loss: f64,
     /// How training ended: `plateau` (converged by the plateau rule), `capped` (reached
-    /// the step cap first), `flattened` (fixed schedule, last windows within 1%),
-    /// `not flattened`, or `-` for references.
+    /// the step cap first), `flattened` (fixed schedule, last windows within 1% or the
+    /// noise) or `not flattened`, then which iterate the main job kept, or `-` for
+    /// references.
     pub convergence: String,
     /// Wall time of the whole run (sampling, training, surface, measuring).
     pub total_seconds: f64,
@@ -160,13 +161,25 @@ fn voronoi_run(sphere: &TriMesh, k: usize, budget: &Budget, seed: u64) -> Result
                 m,
                 (out.report.timings_seconds.train, steps),
                 losses.last().copied().unwrap_or(f64::NAN),
-                if flat { "flattened" } else { "not flattened" },
+                &voronoi_convergence(flat, out.report.losses.selected.map(|s| s.step), steps),
                 t.elapsed().as_secs_f64(),
             );
             return Ok((row, out.crust));
         }
         steps *= 2;
         doublings += 1;
+    }
+}
+
+/// The Voronoi row's `convergence`: whether the loss flattened, and which iterate the
+/// main job kept (its best by the fixed evaluation batch).
+fn voronoi_convergence(flat: bool, kept: Option<usize>, steps: usize) -> String {
+    let flat = if flat { "flattened" } else { "not flattened" };
+    match kept {
+        Some(s) if s == steps => format!("{flat}; kept the last iterate"),
+        Some(0) => format!("{flat}; kept the initialisation"),
+        Some(s) => format!("{flat}; kept step {}", s),
+        None => flat.to_string(),
     }
 }
 

@@ -254,12 +254,17 @@ fn write_table(out: &Path, summaries: &[Summary], budget: &Budget, seconds: f64)
         budget.samples,
         budget.icosphere_subdivisions,
         budget.voronoi_steps.map_or("600 (the default)".into(), |s| s.to_string()),
-        if budget.voronoi_max_doublings == 0 {
-            " on its cosine schedule (the last tenth's mean loss against the tenth before: `flattened` when within 1%)"
-                .to_string()
-        } else {
-            format!(", doubled while the loss had not flattened, up to {}×", 1usize << budget.voronoi_max_doublings)
-        },
+        format!(
+            " on its cosine schedule, keeping its best iterate by a fixed evaluation batch's loss (measured every {} \
+             steps); `flattened` when the last tenth's mean loss is not below the tenth before's by more than 1% or \
+             two standard errors{}",
+            soft_voronoi::TrainConfig::default_for(8192).select_every,
+            if budget.voronoi_max_doublings == 0 {
+                String::new()
+            } else {
+                format!("; steps doubled while not flattened, up to {}×", 1usize << budget.voronoi_max_doublings)
+            }
+        ),
         budget.mlp_lr,
         budget.mlp_batch,
         rule.factor,

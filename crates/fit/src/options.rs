@@ -1,0 +1,107 @@
+//! The main job's options as users give them: one definition for `voronoi-fit fit`'s flags
+//! and the Python package's keyword arguments, turned into a [`FitConfig`] by one function,
+//! so the two front ends cannot drift apart.
+
+use serde::{Deserialize, Serialize};
+use soft_voronoi::{Init, TrainConfig};
+
+use crate::config::{FitConfig, SolidRule, DEFAULT_SITES};
+use crate::error::FitError;
+
+/// What a user may set (every field optional: `None` or `false` keeps the default of
+/// [`FitConfig::new`] and [`TrainConfig::default_for`]). File paths, checkpoints and the
+/// output precision are the front end's business.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FitOptions {
+    /// Trainable sites K (default 8,192).
+    pub sites: Option<usize>,
+    /// Optimisation steps.
+    pub steps: Option<usize>,
+    /// Seed of the samples, the initialisation and the batches.
+    pub seed: u64,
+    /// `default` or `paper` (the seed paper's setting: no relabelling, no insertion).
+    pub preset: Option<String>,
+    /// Initialisation.
+    pub init: Option<Init>,
+    /// Training samples per step.
+    pub batch: Option<usize>,
+    /// Initial learning rate (the cosine schedule keeps its final/initial ratio).
+    pub lr: Option<f64>,
+    /// β annealing start.
+    pub beta_start: Option<f64>,
+    /// Pairs' distance from the surface, as a fraction of their spacing.
+    pub surface_offset: Option<f64>,
+    /// Signed-distance weight.
+    pub w_sdf: Option<f64>,
+    /// Centroidal weight.
+    pub w_centroidal: Option<f64>,
+    /// Normal-alignment weight inside the surface term.
+    pub w_normal: Option<f64>,
+    /// Reconstruction weight.
+    pub w_reconstruction: Option<f64>,
+    /// Surface-term weight.
+    pub w_surface: Option<f64>,
+    /// Training sample pool (default 1,000,000).
+    pub samples: Option<usize>,
+    /// Fresh samples for the misclassification figure (default 1,000,000).
+    pub eval_samples: Option<usize>,
+    /// The solid to fit.
+    pub solid: SolidRule,
+    /// Shell thickness as a fraction of the diagonal.
+    pub shell_thickness: Option<f64>,
+    /// Keep the training labels.
+    pub no_relabel: bool,
+    /// Carving tolerance as a fraction of the diagonal (default 0.3%).
+    pub carve: Option<f64>,
+    /// No carving.
+    pub no_carve: bool,
+    /// Skip the metrics against the input (faster; the report says so).
+    pub skip_metrics: bool,
+}
+
+impl FitOptions {
+    /// The validated settings for a mesh called `name` (used in messages and the report).
+    ///
+    /// # Errors
+    /// [`FitError::Input`] naming the bad option.
+    pub fn to_config(&self, name: &str) -> Result<FitConfig, FitError> {
+        let preset = self.preset.as_deref().unwrap_or("default");
+        let paper = match preset {
+            "default" => false,
+            "paper" => true,
+            other => return Err(FitError::Input(format!("preset `{other}`: use `default` or `paper`"))),
+        };
+        let mut c = FitConfig::new(name, self.sites.unwrap_or(DEFAULT_SITES));
+        c.sampling.samples = self.samples.unwrap_or(c.sampling.samples);
+        c.sampling.solid = self.solid;
+        c.sampling.shell_thickness = self.shell_thickness;
+        c.train_shell = self.steps.is_some();
+        // The paper preset is the paper's method: no relabelling, no insertion.
+        c.relabel = !self.no_relabel && !paper;
+        c.carve = if self.no_carve || (paper && self.carve.is_none()) { None } else { self.carve.or(c.carve) };
+        c.eval.samples = self.eval_samples.unwrap_or(c.eval.samples);
+        c.preset = preset.to_string();
+        c.skip_metrics = self.skip_metrics;
+        let k = c.train.num_sites;
+        let mut t = if paper { TrainConfig::paper(k) } else { TrainConfig::default_for(k) };
+        t.steps = self.steps.unwrap_or(t.steps);
+        t.init = self.init.unwrap_or(t.init);
+        t.batch = self.batch.unwrap_or(t.batch);
+        if let Some(lr) = self.lr {
+            t.lr_final = if paper { lr } else { lr * (t.lr_final / t.lr) };
+            t.lr = lr;
+        }
+        t.beta_start = self.beta_start.or(t.beta_start);
+        t.surface_offset = self.surface_offset.unwrap_or(t.surface_offset);
+        t.weights.signed_distance = self.w_sdf.unwrap_or(t.weights.signed_distance);
+        t.weights.centroidal = self.w_centroidal.unwrap_or(t.weights.centroidal);
+        t.weights.surface = self.w_surface.unwrap_or(t.weights.surface);
+        t.weights.reconstruction = self.w_reconstruction.unwrap_or(t.weights.reconstruction);
+        t.weights.normal = self.w_normal.unwrap_or(t.weights.normal);
+        c.train = t;
+        let c = c.with_seed(self.seed);
+        c.validate()?;
+        Ok(c)
+    }
+}

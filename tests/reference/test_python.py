@@ -1,0 +1,213 @@
+"""The Python package (`import voronoi_fit`, built by tests/run.sh with maturin into the
+test venv) against the CLI's own outputs and against libigl / scipy:
+
+- `fit` gives bit for bit the sites and crust that `voronoi-fit MESH -o OUT.obj` writes
+  with the same options, and the same report figures; trimesh objects, (V, F) pairs and
+  paths give the same result;
+- `crust` of the fit's sites is the fit's crust; of the sites in the mesh frame, a closed
+  mesh of the same volume;
+- `winding_number` (exact: 1e-9; fast: 1e-3 and no flips) and `signed_distance` against
+  `igl.winding_number` / `igl.point_mesh_squared_distance`; `delaunay` against
+  scipy.spatial.Delaunay; `hausdorff` and `evaluate` against `voronoi-fit eval` and
+  `igl.hausdorff`;
+- errors are `InputError` (a ValueError) with the CLI's message; an exception in the
+  progress callback stops the fit and is raised; the GIL is released during a fit.
+"""
+import json
+import threading
+import time
+
+import igl
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial import Delaunay
+
+import voronoi_fit as vf
+
+from conftest import ROOT, SHARED, run
+
+BUNNY = ROOT / "assets" / "bunny.obj"
+SMALL = dict(sites=512, steps=30, samples=20000, eval_samples=2000)
+SMALL_CLI = ["--sites", "512", "--steps", "30", "--samples", "20000", "--eval-samples", "2000"]
+
+
+@pytest.fixture(scope="module")
+def bunny():
+    return vf.load_mesh(BUNNY)
+
+
+@pytest.fixture(scope="module")
+def fitted(bunny):
+    return vf.fit(bunny, name=str(BUNNY), progress=False, **SMALL)
+
+
+def test_fit_equals_the_cli(fitted, tmp_path):
+    out = tmp_path / "b.obj"
+    run(BUNNY, "-o", out, "--quiet", *SMALL_CLI)
+    sites = np.load(tmp_path / "b.sites.npz")
+    assert np.array_equal(sites["sites"], fitted.sites_unit)
+    assert np.array_equal(sites["labels"].astype(bool), fitted.labels)
+    V, F = vf.load_mesh(out)
+    assert V.shape == fitted.crust_vertices.shape and np.array_equal(F, fitted.crust_faces)
+    assert np.array_equal(V, fitted.crust_vertices), "the CLI's OBJ holds the same float64 crust"
+    report = json.loads((tmp_path / "b.report.json").read_text())
+    for path in (["metrics", "hausdorff", "hi"], ["metrics", "surface", "chamfer_l1"], ["quality", "misclassification"]):
+        a, b = report, fitted.report
+        for k in path:
+            a, b = a[k], b[k]
+        assert a == b, path
+    assert fitted.report["settings"]["train"]["num_sites"] == 512
+    assert "Hausdorff" in fitted.summary()
+
+
+def test_inputs_as_trimesh_path_and_arrays_agree(bunny, fitted):
+    tm = trimesh.Trimesh(bunny[0], bunny[1], process=False)
+    by_trimesh = vf.fit(tm, progress=False, **SMALL)
+    by_path = vf.fit(BUNNY, progress=False, **SMALL)
+    by_arrays = vf.fit(bunny[0], bunny[1], progress=False, **SMALL)
+    for r in (by_trimesh, by_path, by_arrays):
+        assert np.array_equal(r.crust_vertices, fitted.crust_vertices)
+        assert np.array_equal(r.sites, fitted.sites)
+    assert by_path.report["input"]["path"] == str(BUNNY)
+    assert isinstance(by_trimesh.to_trimesh(), trimesh.Trimesh)
+
+
+def test_crust_of_the_fit_sites(fitted):
+    V, F = vf.crust(fitted.sites_unit, fitted.labels, fitted.transform)
+    # The same polygons; positions equal up to the last bits (the fit maps its crust by
+    # centre and scale, the 4×4 matrix rounds differently).
+    assert np.array_equal(F, fitted.crust_faces)
+    assert np.max(np.abs(V - fitted.crust_vertices)) <= 1e-12 * np.ptp(V)
+    # In the mesh frame, without a transform: the same diagram up to rounding, closed.
+    V2, F2 = vf.crust(fitted.sites, fitted.labels)
+    m, m2 = trimesh.Trimesh(V, F, process=False), trimesh.Trimesh(V2, F2, process=False)
+    assert m2.is_watertight and m2.is_winding_consistent
+    assert abs(m2.volume - m.volume) <= 1e-6 * abs(m.volume)
+
+
+def test_winding_numbers_and_distances_equal_libigl(bunny):
+    V, F = bunny
+    rng = np.random.default_rng(3)
+    lo, hi = V.min(0), V.max(0)
+    Q = lo + (hi - lo) * rng.uniform(-0.1, 1.1, size=(20000, 3))
+    w_igl = igl.winding_number(V, F, Q)
+    exact = vf.winding_number(V, F, Q, exact=True)
+    assert np.max(np.abs(exact - w_igl)) < 1e-9
+    fast = vf.winding_number((V, F), Q)
+    assert np.max(np.abs(fast - w_igl)) < 1e-3
+    assert np.array_equal(np.abs(fast) >= 0.5, np.abs(w_igl) >= 0.5), "the fast winding number flipped a side"
+    d, C, T = vf.signed_distance(V, F, Q, return_closest=True)
+    sqrd, I, C_igl = igl.point_mesh_squared_distance(Q, V, F)
+    assert np.allclose(np.abs(d), np.sqrt(sqrd), rtol=0, atol=1e-12 * np.ptp(V))
+    assert np.array_equal(d < 0, np.abs(w_igl) >= 0.5)
+    assert np.allclose(np.sum((C - Q) ** 2, axis=1), sqrd, rtol=1e-9, atol=1e-15)
+    assert T.shape == (len(Q),) and T.max() < len(F)
+
+
+def test_delaunay_equals_scipy():
+    rng = np.random.default_rng(5)
+    P = rng.uniform(size=(2000, 3))
+    ours = np.sort(vf.delaunay(P).astype(np.int64), axis=1)
+    ref = np.sort(Delaunay(P).simplices.astype(np.int64), axis=1)
+    assert set(map(tuple, ours)) == set(map(tuple, ref))
+    a, b, c, d = (P[ours[:, i]] for i in range(4))
+    # Positively oriented, as documented.
+    t = vf.delaunay(P)
+    a, b, c, d = (P[t[:, i]] for i in range(4))
+    assert np.all(np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) > 0)
+
+
+def test_hausdorff_and_evaluate_equal_the_cli(bunny, fitted, tmp_path):
+    pred = tmp_path / "pred.obj"
+    trimesh.Trimesh(fitted.crust_vertices, fitted.crust_faces, process=False).export(pred)
+    cli = json.loads(run("eval", BUNNY, pred, "--json").stdout)
+    ours = vf.evaluate(BUNNY, pred)
+    for k in ("lo", "hi"):
+        assert ours["hausdorff"][k] == cli["hausdorff"][k]
+    for k in ("chamfer_l1", "fscore", "normal_consistency"):
+        assert ours["surface"][k] == cli["surface"][k]
+    assert ours["hausdorff_libigl"] == cli["hausdorff_libigl"]
+    lo, hi = vf.hausdorff(bunny, fitted)
+    assert lo <= hi
+    V, F = bunny
+    h_igl = igl.hausdorff(V, F, fitted.crust_vertices, fitted.crust_faces.astype(np.int64))
+    assert lo >= h_igl * (1 - 1e-12), "the certified interval starts at or above libigl's vertex value"
+
+
+def test_errors_are_input_errors_with_the_cli_message(bunny, tmp_path):
+    V, F = bunny
+    bad = V.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(vf.InputError, match="row 7 is not finite"):
+        vf.winding_number(bad, F, V[:3])
+    with pytest.raises(ValueError, match="refers to a vertex beyond"):
+        vf.fit(V, F + len(V), progress=False, **SMALL)
+    with pytest.raises(vf.InputError, match=r"\(n, 3\)"):
+        vf.delaunay(np.zeros((4, 2)))
+    with pytest.raises(vf.InputError, match="unknown fit option"):
+        vf.fit(bunny, progress=False, stepz=3)
+    with pytest.raises(vf.InputError, match="at least twice"):
+        vf.fit(bunny, progress=False, sites=512, samples=1000)
+    malformed = ROOT / "tests" / "malformed" / "nan_vertex.obj"
+    cli = run("info", malformed, check=False)
+    with pytest.raises(vf.InputError) as e:
+        vf.load_mesh(malformed)
+    assert str(e.value) in cli.stderr and "nan_vertex.obj" in str(e.value)
+    with pytest.raises(vf.InputError):
+        vf.fit(np.zeros((3, 3)), np.array([[0, 1, 2]]), progress=False, **SMALL)
+
+
+def test_progress_callback_sees_every_step_and_can_stop(bunny):
+    seen = []
+    vf.fit(bunny, progress=lambda stage, step, steps, loss: seen.append((stage, step, steps)), **SMALL)
+    train = [s for s in seen if s[0] == "train" and s[1] > 0]
+    assert [s[1] for s in train] == list(range(1, 31)) and all(s[2] == 30 for s in train)
+    assert {"sample", "crust", "metrics"} <= {s[0] for s in seen}
+
+    class Stop(Exception):
+        pass
+
+    def stop_at_5(stage, step, steps, loss):
+        if stage == "train" and step == 5:
+            raise Stop()
+
+    with pytest.raises(Stop):
+        vf.fit(bunny, progress=stop_at_5, **SMALL)
+
+
+def test_the_gil_is_released_during_a_fit(bunny):
+    """A Python thread keeps running while a fit works (with the GIL held it would stall
+    for the whole native call)."""
+    ticks = []
+    done = threading.Event()
+
+    def ticker():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.005)
+
+    t = threading.Thread(target=ticker)
+    t.start()
+    t0 = time.perf_counter()
+    vf.fit(bunny, progress=False, **{**SMALL, "steps": 60})
+    t1 = time.perf_counter()
+    done.set()
+    t.join()
+    during = [x for x in ticks if t0 < x < t1]
+    assert t1 - t0 > 0.3
+    assert len(during) >= 10, f"{len(during)} ticks in a {t1 - t0:.2f} s fit"
+
+
+def test_soup_and_open_meshes_fit(tmp_path):
+    for name in ["mikedh__soup.stl", "mikedh__teapot.stl"]:
+        r = vf.fit(SHARED / name, progress=False, **SMALL)
+        m = r.to_trimesh()
+        assert m.is_watertight and len(r.crust_faces) > 0, name
+
+
+def test_stub_lists_every_public_name():
+    stub = (ROOT / "crates" / "python" / "python" / "voronoi_fit" / "__init__.pyi").read_text()
+    for name in vf.__all__:
+        assert name in stub, name
+    assert all(vf.__dict__[n].__doc__ for n in vf.__all__), "every public name has a docstring"
