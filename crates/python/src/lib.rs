@@ -160,7 +160,7 @@ type FitBytes<'py> =
 /// fields). Returns (sites in the unit cube, labels, 4×4 unit-cube → mesh transform, crust
 /// vertices in the mesh frame at float64, crust faces, report JSON).
 #[pyfunction]
-#[pyo3(name = "fit", signature = (vertices, faces, name, options_json, callback=None))]
+#[pyo3(name = "fit", signature = (vertices, faces, name, options_json, callback=None, float32=false))]
 fn fit_mesh<'py>(
     py: Python<'py>,
     vertices: &[u8],
@@ -168,13 +168,15 @@ fn fit_mesh<'py>(
     name: &str,
     options_json: &str,
     callback: Option<Py<PyAny>>,
+    float32: bool,
 ) -> PyResult<FitBytes<'py>> {
     let input = mesh(vertices, faces, name)?;
     let options: FitOptions =
         serde_json::from_str(options_json).map_err(|e| input_error(format!("fit options: {e}")))?;
     let mut config = options.to_config(name).map_err(|e| input_error(e))?;
-    // Lossless output: the arrays are float64 (the CLI rounds to float32 only for glTF).
-    config.output_precision = ::crust::output::Precision::F64;
+    // float64 unless asked: the CLI rounds (and checks again) at float32 only for glTF, and
+    // so does `float32` here, for a crust that will be saved as GLB.
+    config.output_precision = if float32 { ::crust::output::Precision::F32 } else { ::crust::output::Precision::F64 };
     let mut progress = PyProgress { callback, error: None, steps: 0 };
     let result = py.allow_threads(|| ::fit::fit(&input, &config, &mut progress));
     if let Some(e) = progress.error.take() {
@@ -233,6 +235,36 @@ fn crust_of_sites<'py>(py: Python<'py>, sites: &[u8], labels: &[u8], transform: 
     });
     let m = result.map_err(input_error)?;
     Ok((f64_bytes(py, &m.positions), u32_bytes(py, &m.triangles)))
+}
+
+/// Writes a mesh atomically (temporary file, then rename) in the format of the path's
+/// extension (.glb, .gltf, .obj, .ply), as the CLI writes its outputs.
+#[pyfunction]
+fn save_mesh(py: Python<'_>, path: &str, vertices: &[u8], faces: &[u8]) -> PyResult<()> {
+    let m = mesh(vertices, faces, path)?;
+    py.allow_threads(|| mesh_io::write_mesh(std::path::Path::new(path), &m)).map_err(|e| {
+        if e.kind == mesh_io::ErrorKind::Write {
+            failure(e)
+        } else {
+            input_error(e)
+        }
+    })
+}
+
+/// Writes a sites file (`.npz`: sites in the unit cube, labels, 4×4 transform) atomically,
+/// the file `voronoi-fit crust` reads.
+#[pyfunction]
+fn save_sites(py: Python<'_>, path: &str, sites: &[u8], labels: &[u8], transform: &[u8]) -> PyResult<()> {
+    let sites = rows_f64(sites, "sites")?;
+    if labels.len() != sites.len() || transform.len() != 128 {
+        return Err(input_error("save_sites: one label per site and a 4×4 float64 transform"));
+    }
+    let mut m = [[0.0; 4]; 4];
+    for (k, c) in transform.chunks_exact(8).enumerate() {
+        m[k / 4][k % 4] = f64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
+    }
+    let file = ::crust::SitesFile { sites, inside: labels.iter().map(|&b| b != 0).collect(), transform: m };
+    py.allow_threads(|| file.write(std::path::Path::new(path))).map_err(failure)
 }
 
 fn oracle(v: &[u8], f: &[u8]) -> PyResult<occupancy::MeshOracle> {
@@ -325,5 +357,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(delaunay, m)?)?;
     m.add_function(wrap_pyfunction!(hausdorff, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(save_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(save_sites, m)?)?;
     Ok(())
 }

@@ -39,6 +39,7 @@ __all__ = [
     "fit",
     "hausdorff",
     "load_mesh",
+    "save_mesh",
     "signed_distance",
     "winding_number",
 ]
@@ -121,6 +122,22 @@ def load_mesh(path: "str | os.PathLike[str]") -> tuple[np.ndarray, np.ndarray]:
     return _from(v, "<f8", 3), _from(f, "<u4", 3)
 
 
+def save_mesh(path: "str | os.PathLike[str]", vertices: Any, faces: Any) -> None:
+    """Write a mesh atomically (temporary file beside it, then rename) as the CLI writes
+    its outputs: .glb, .gltf (+ .bin), .obj or binary .ply by the extension."""
+    v, f = _rows(vertices, "vertices"), _faces(faces, "faces")
+    _native.save_mesh(os.fspath(path), v.tobytes(), f.tobytes())
+
+
+def _atomic_text(path: str, text: str) -> None:
+    tmp = f"{path}.tmp{os.getpid()}"
+    with open(tmp, "w") as fh:
+        fh.write(text)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
 class FitResult:
     """What :func:`fit` returns.
 
@@ -150,6 +167,24 @@ class FitResult:
         import trimesh
 
         return trimesh.Trimesh(self.crust_vertices, self.crust_faces, process=False)
+
+    def save(self, prefix: "str | os.PathLike[str]", format: str = "glb") -> dict:
+        """Write ``PREFIX.voronoi.FORMAT`` (the crust), ``PREFIX.voronoi.sites.npz`` and
+        ``PREFIX.voronoi.report.json``, each atomically, as ``voronoi-fit MESH -o
+        PREFIX.voronoi.FORMAT`` names them; returns the paths. A .glb/.gltf crust should
+        come from ``fit(..., float32=True)`` (float64 positions are refused there unless
+        float32 holds them exactly)."""
+        base = os.fspath(prefix) + ".voronoi"
+        paths = {"crust": f"{base}.{format}", "sites": f"{base}.sites.npz", "report": f"{base}.report.json"}
+        _native.save_sites(
+            paths["sites"],
+            np.ascontiguousarray(self.sites_unit, dtype="<f8").tobytes(),
+            np.ascontiguousarray(self.labels, dtype=np.uint8).tobytes(),
+            np.ascontiguousarray(self.transform, dtype="<f8").tobytes(),
+        )
+        save_mesh(paths["crust"], self.crust_vertices, self.crust_faces)
+        _atomic_text(paths["report"], json.dumps(self.report, indent=2))
+        return paths
 
     def summary(self) -> str:
         """The figures people look at first."""
@@ -202,6 +237,7 @@ def fit(
     carve: "float | bool" = True,
     progress: "Callable[[str, int, int, float], Any] | bool | None" = None,
     name: Optional[str] = None,
+    float32: bool = False,
     **options: Any,
 ) -> FitResult:
     """Fit ``sites`` labelled Voronoi sites to a mesh and extract the watertight crust:
@@ -221,6 +257,8 @@ def fit(
             when tqdm is installed and stderr is a terminal; False shows nothing. An
             exception raised by the callable, or Ctrl-C, stops the fit and is raised.
         name: the mesh's name in messages and the report (default: the path, or "mesh").
+        float32: round the crust to float32 and check it again as rounded, as the CLI does
+            for glTF outputs (use it before :func:`save_mesh` to a .glb); default float64.
         **options: the CLI's other fit options by their long names: steps, preset
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
@@ -254,7 +292,7 @@ def fit(
         except ImportError:
             pass
     try:
-        s, l, t, cv, cf, report = _native.fit(v.tobytes(), f.tobytes(), name, json.dumps(opts), callback)
+        s, l, t, cv, cf, report = _native.fit(v.tobytes(), f.tobytes(), name, json.dumps(opts), callback, bool(float32))
     finally:
         if bar is not None:
             bar.close()

@@ -28,6 +28,7 @@ class FitResult:
     crust_faces: npt.NDArray[np.uint32]
     report: dict[str, Any]
     def to_trimesh(self) -> Any: ...
+    def save(self, prefix: Union[str, os.PathLike[str]], format: str = "glb") -> dict[str, str]: ...
     def summary(self) -> str: ...
 
 def load_mesh(path: Union[str, os.PathLike[str]]) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]: ...
@@ -41,6 +42,7 @@ def fit(
     carve: Union[float, bool] = True,
     progress: Union[Progress, bool, None] = None,
     name: Optional[str] = None,
+    float32: bool = False,
     steps: Optional[int] = None,
     preset: Optional[str] = None,
     init: Optional[str] = None,
@@ -59,6 +61,7 @@ def fit(
     shell_thickness: Optional[float] = None,
     skip_metrics: Optional[bool] = None,
 ) -> FitResult: ...
+def save_mesh(path: Union[str, os.PathLike[str]], vertices: npt.ArrayLike, faces: npt.ArrayLike) -> None: ...
 def crust(
     sites: npt.ArrayLike, labels: npt.ArrayLike, transform: Optional[npt.ArrayLike] = None
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]: ...
