@@ -15,6 +15,7 @@ test venv) against the CLI's own outputs and against libigl / scipy:
 """
 import json
 import threading
+from pathlib import Path
 import time
 
 import igl
@@ -25,7 +26,7 @@ from scipy.spatial import Delaunay
 
 import voronoi_fit as vf
 
-from conftest import ROOT, SHARED, run
+from conftest import ROOT, SHARED, assert_gltf_valid, run
 
 BUNNY = ROOT / "assets" / "bunny.obj"
 SMALL = dict(sites=512, steps=30, samples=20000, eval_samples=2000)
@@ -39,7 +40,8 @@ def bunny():
 
 @pytest.fixture(scope="module")
 def fitted(bunny):
-    return vf.fit(bunny, name=str(BUNNY), progress=False, **SMALL)
+    # float64, to compare with the CLI's lossless .obj output.
+    return vf.fit(bunny, name=str(BUNNY), progress=False, float32=False, **SMALL)
 
 
 def test_fit_equals_the_cli(fitted, tmp_path):
@@ -63,9 +65,9 @@ def test_fit_equals_the_cli(fitted, tmp_path):
 
 def test_inputs_as_trimesh_path_and_arrays_agree(bunny, fitted):
     tm = trimesh.Trimesh(bunny[0], bunny[1], process=False)
-    by_trimesh = vf.fit(tm, progress=False, **SMALL)
-    by_path = vf.fit(BUNNY, progress=False, **SMALL)
-    by_arrays = vf.fit(bunny[0], bunny[1], progress=False, **SMALL)
+    by_trimesh = vf.fit(tm, progress=False, float32=False, **SMALL)
+    by_path = vf.fit(BUNNY, progress=False, float32=False, **SMALL)
+    by_arrays = vf.fit(bunny[0], bunny[1], progress=False, float32=False, **SMALL)
     for r in (by_trimesh, by_path, by_arrays):
         assert np.array_equal(r.crust_vertices, fitted.crust_vertices)
         assert np.array_equal(r.sites, fitted.sites)
@@ -211,3 +213,17 @@ def test_stub_lists_every_public_name():
     for name in vf.__all__:
         assert name in stub, name
     assert all(vf.__dict__[n].__doc__ for n in vf.__all__), "every public name has a docstring"
+
+
+def test_saved_files_are_the_cli_files_and_the_glb_is_valid(bunny, tmp_path):
+    r = vf.fit(BUNNY, progress=False, **SMALL)  # float32 by default, as the CLI's GLB
+    paths = r.save(tmp_path / "py")
+    assert_gltf_valid(paths["crust"])
+    run(BUNNY, "-o", tmp_path / "cli.voronoi.glb", "--quiet", *SMALL_CLI)
+    assert (tmp_path / "cli.voronoi.glb").read_bytes() == Path(paths["crust"]).read_bytes()
+    cli_sites, py_sites = np.load(tmp_path / "cli.voronoi.sites.npz"), np.load(paths["sites"])
+    for k in ("sites", "labels", "transform"):
+        assert np.array_equal(cli_sites[k], py_sites[k]), k
+    with pytest.raises(vf.InputError, match="float32=True"):
+        vf.fit(BUNNY, progress=False, float32=False, **SMALL).save(tmp_path / "f64")
+    assert not list(tmp_path.glob("f64*")), "nothing written when refused"

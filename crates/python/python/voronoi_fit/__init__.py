@@ -124,7 +124,9 @@ def load_mesh(path: "str | os.PathLike[str]") -> tuple[np.ndarray, np.ndarray]:
 
 def save_mesh(path: "str | os.PathLike[str]", vertices: Any, faces: Any) -> None:
     """Write a mesh atomically (temporary file beside it, then rename) as the CLI writes
-    its outputs: .glb, .gltf (+ .bin), .obj or binary .ply by the extension."""
+    its outputs: .glb, .gltf (+ .bin), .obj or binary .ply by the extension. glTF holds
+    float32, so positions are rounded there (for a crust, fit with ``float32=True``
+    first: see :meth:`FitResult.save`)."""
     v, f = _rows(vertices, "vertices"), _faces(faces, "faces")
     _native.save_mesh(os.fspath(path), v.tobytes(), f.tobytes())
 
@@ -171,9 +173,16 @@ class FitResult:
     def save(self, prefix: "str | os.PathLike[str]", format: str = "glb") -> dict:
         """Write ``PREFIX.voronoi.FORMAT`` (the crust), ``PREFIX.voronoi.sites.npz`` and
         ``PREFIX.voronoi.report.json``, each atomically, as ``voronoi-fit MESH -o
-        PREFIX.voronoi.FORMAT`` names them; returns the paths. A .glb/.gltf crust should
-        come from ``fit(..., float32=True)`` (float64 positions are refused there unless
-        float32 holds them exactly)."""
+        PREFIX.voronoi.FORMAT`` names them; returns the paths. A .glb/.gltf crust must
+        come from ``fit(..., float32=True)``, which rounds and checks it as glTF stores it
+        (a float64 crust is refused there with that advice); .obj and .ply keep float64."""
+        if format in ("glb", "gltf") and not np.array_equal(
+            self.crust_vertices.astype(np.float32).astype(np.float64), self.crust_vertices
+        ):
+            raise InputError(
+                f"the crust is float64; glTF stores float32, and rounding it now could break the checked crust. "
+                f"Fit with float32=True (as the CLI does for .glb), or save as obj or ply"
+            )
         base = os.fspath(prefix) + ".voronoi"
         paths = {"crust": f"{base}.{format}", "sites": f"{base}.sites.npz", "report": f"{base}.report.json"}
         _native.save_sites(
@@ -237,12 +246,13 @@ def fit(
     carve: "float | bool" = True,
     progress: "Callable[[str, int, int, float], Any] | bool | None" = None,
     name: Optional[str] = None,
-    float32: bool = False,
+    float32: bool = True,
     **options: Any,
 ) -> FitResult:
     """Fit ``sites`` labelled Voronoi sites to a mesh and extract the watertight crust:
     the main job, exactly as ``voronoi-fit MESH --sites K --seed N`` runs it (the crust is
-    kept at float64 here, as the CLI does for .obj/.ply outputs).
+    rounded to float32 and checked again as rounded, as for the CLI's default GLB output,
+    unless ``float32=False``).
 
     Args:
         mesh: (vertices, faces), a trimesh.Trimesh, a path, or vertices with ``faces``.
@@ -258,7 +268,9 @@ def fit(
             exception raised by the callable, or Ctrl-C, stops the fit and is raised.
         name: the mesh's name in messages and the report (default: the path, or "mesh").
         float32: round the crust to float32 and check it again as rounded, as the CLI does
-            for glTF outputs (use it before :func:`save_mesh` to a .glb); default float64.
+            for its default GLB output (so ``result.save(prefix)`` writes exactly the file
+            ``voronoi-fit MESH`` writes); False keeps float64, as the CLI does for .obj and
+            .ply outputs.
         **options: the CLI's other fit options by their long names: steps, preset
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,

@@ -42,7 +42,7 @@ def fit(
     carve: Union[float, bool] = True,
     progress: Union[Progress, bool, None] = None,
     name: Optional[str] = None,
-    float32: bool = False,
+    float32: bool = True,
     steps: Optional[int] = None,
     preset: Optional[str] = None,
     init: Optional[str] = None,
