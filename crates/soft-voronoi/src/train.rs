@@ -297,41 +297,16 @@ impl<'a> Trainer<'a> {
     /// (so iterates are compared on one scale whatever the annealing), without touching
     /// the optimiser. Centroidal and signed-distance terms use the state's last refresh.
     fn selection_loss(&self, batch: &SelectionBatch) -> f64 {
-        let st = &self.state;
-        let cfg = &st.config;
-        let k = cfg.num_sites;
-        let w = &cfg.weights;
+        let cfg = &self.state.config;
         let kernel = Kernel { beta: cfg.beta, tau: cfg.tau };
-        let mut grad = vec![[0.0; 3]; k];
-        let index = SiteIndex::new(&st.sites);
-        let rec = losses::reconstruction(
-            &kernel,
-            &index,
-            &st.sites,
-            &st.labels,
-            &batch.points,
-            &batch.occupancy,
-            w.reconstruction,
-            &mut grad,
-        );
-        let bnd = losses::bounds(&st.sites[..k], w.bounds, &mut grad);
-        let sdf = if w.signed_distance > 0.0 && st.located.len() == k {
-            losses::signed_distance_cached(&st.located, &st.sites[..k], &st.labels[..k], w.signed_distance, &mut grad)
-        } else {
-            0.0
+        let mut grad = vec![[0.0; 3]; cfg.num_sites];
+        let batch = Batch {
+            points: &batch.points,
+            occupancy: &batch.occupancy,
+            surface: &batch.surface,
+            normals: &batch.normals,
         };
-        let cen = if w.centroidal > 0.0 && st.graph.num_sites() == st.sites.len() {
-            losses::centroidal(&st.graph, &st.sites, w.centroidal, &mut grad)
-        } else {
-            0.0
-        };
-        let srf = if w.surface > 0.0 && !batch.surface.is_empty() {
-            let labelled = losses::LabelledIndex::new(&st.sites, &st.labels);
-            losses::surface(&labelled, &st.sites, &batch.surface, &batch.normals, w.normal, w.surface, &mut grad)
-        } else {
-            0.0
-        };
-        w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen + w.surface * srf
+        objective(&self.state, &kernel, &batch, &mut grad).total
     }
 
     /// Measures the current sites on the evaluation batch and keeps them if they are the
@@ -405,60 +380,26 @@ impl<'a> Trainer<'a> {
             self.batch_points.push(self.data.points[i]);
             self.batch_occupancy.push(self.data.occupancy[i]);
         }
-        self.grad.iter_mut().for_each(|g| *g = [0.0; 3]);
-        let index = SiteIndex::new(&st.sites);
-        let rec = losses::reconstruction(
-            &kernel,
-            &index,
-            &st.sites,
-            &st.labels,
-            &self.batch_points,
-            &self.batch_occupancy,
-            w.reconstruction,
-            &mut self.grad,
-        );
-        let bnd = losses::bounds(&st.sites[..k], w.bounds, &mut self.grad);
-        let sdf = if w.signed_distance > 0.0 {
-            losses::signed_distance_cached(
-                &st.located,
-                &st.sites[..k],
-                &st.labels[..k],
-                w.signed_distance,
-                &mut self.grad,
-            )
-        } else {
-            0.0
-        };
-        let cen = if w.centroidal > 0.0 {
-            losses::centroidal(&st.graph, &st.sites, w.centroidal, &mut self.grad)
-        } else {
-            0.0
-        };
-        let srf = if w.surface > 0.0 && !self.data.surface.is_empty() {
+        self.surface_points.clear();
+        self.surface_normals.clear();
+        if w.surface > 0.0 && !self.data.surface.is_empty() {
             let mut rng = ChunkRng::for_chunk(cfg.seed, Stream::SurfaceBatch, t as u64);
             let m = self.data.surface.len() as u64;
-            self.surface_points.clear();
-            self.surface_normals.clear();
             for _ in 0..cfg.surface_batch {
                 let i = (rng.next_u64() % m) as usize;
                 self.surface_points.push(self.data.surface[i]);
                 self.surface_normals.push(self.data.normals.get(i).copied().unwrap_or([0.0; 3]));
             }
-            let labelled = losses::LabelledIndex::new(&st.sites, &st.labels);
-            losses::surface(
-                &labelled,
-                &st.sites,
-                &self.surface_points,
-                &self.surface_normals,
-                w.normal,
-                w.surface,
-                &mut self.grad,
-            )
-        } else {
-            0.0
+        }
+        self.grad.iter_mut().for_each(|g| *g = [0.0; 3]);
+        let batch = Batch {
+            points: &self.batch_points,
+            occupancy: &self.batch_occupancy,
+            surface: &self.surface_points,
+            normals: &self.surface_normals,
         };
-        let total =
-            w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen + w.surface * srf;
+        let Terms { total, reconstruction: rec, bounds: bnd, signed_distance: sdf, centroidal: cen, surface: srf } =
+            objective(st, &kernel, &batch, &mut self.grad);
         if !total.is_finite() || !self.grad.iter().flatten().all(|g| g.is_finite()) {
             return Err(TrainError::Diverged { step: t, what: format!("loss {total}") });
         }
@@ -499,6 +440,63 @@ impl<'a> Trainer<'a> {
             }
             None => project_sites(&st.sites, &st.labels),
         }
+    }
+}
+
+/// One batch: labelled samples, and surface samples with normals (empty: no surface term).
+struct Batch<'b> {
+    points: &'b [[f64; 3]],
+    occupancy: &'b [bool],
+    surface: &'b [[f64; 3]],
+    normals: &'b [[f64; 3]],
+}
+
+/// The loss terms of [`objective`] (unweighted, as [`StepStats`] reports them) and their
+/// weighted sum.
+struct Terms {
+    total: f64,
+    reconstruction: f64,
+    bounds: f64,
+    signed_distance: f64,
+    centroidal: f64,
+    surface: f64,
+}
+
+/// The training objective of `state`'s sites on `batch` at `kernel`, its gradient added into
+/// `grad` (the trainable sites'): the one definition a training step and the best-iterate
+/// selection share. The signed-distance and centroidal terms use the state's last refresh
+/// (closest points, Delaunay graph).
+fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, grad: &mut [[f64; 3]]) -> Terms {
+    let (sites, labels) = (&state.sites, &state.labels);
+    let k = state.config.num_sites;
+    let w = &state.config.weights;
+    let index = SiteIndex::new(sites);
+    let rec =
+        losses::reconstruction(kernel, &index, sites, labels, batch.points, batch.occupancy, w.reconstruction, grad);
+    let bnd = losses::bounds(&sites[..k], w.bounds, grad);
+    let sdf = if w.signed_distance > 0.0 && state.located.len() == k {
+        losses::signed_distance_cached(&state.located, &sites[..k], &labels[..k], w.signed_distance, grad)
+    } else {
+        0.0
+    };
+    let cen = if w.centroidal > 0.0 && state.graph.num_sites() == sites.len() {
+        losses::centroidal(&state.graph, sites, w.centroidal, grad)
+    } else {
+        0.0
+    };
+    let srf = if w.surface > 0.0 && !batch.surface.is_empty() {
+        let labelled = losses::LabelledIndex::new(sites, labels);
+        losses::surface(&labelled, sites, batch.surface, batch.normals, w.normal, w.surface, grad)
+    } else {
+        0.0
+    };
+    Terms {
+        total: w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen + w.surface * srf,
+        reconstruction: rec,
+        bounds: bnd,
+        signed_distance: sdf,
+        centroidal: cen,
+        surface: srf,
     }
 }
 

@@ -81,8 +81,8 @@ def read_manifest(path: Path) -> list[Path]:
 
 
 def names(paths: list[Path]) -> list[str]:
-    """Output folder names as `voronoi-fit batch` makes them: the stem, made safe; shared
-    stems get a hash of the path."""
+    """Output folder names exactly as `voronoi-fit batch` makes them: the stem, made safe;
+    stems shared by several inputs get the low 32 bits of FNV-1a of the resolved path."""
 
     def stem(p: Path) -> str:
         s = "".join(c if (c.isalnum() or c in "-_.") else "_" for c in p.stem)
@@ -95,10 +95,17 @@ def names(paths: list[Path]) -> list[str]:
     for p in paths:
         s = stem(p)
         if counts[s] > 1:
-            h = hashlib.sha256(str(p.resolve()).encode()).hexdigest()[:8]
-            s = f"{s}-{h}"
+            s = f"{s}-{_fnv1a64(str(p.resolve()).encode()) & 0xFFFFFFFF:08x}"
         out.append(s)
     return out
+
+
+def _fnv1a64(data: bytes) -> int:
+    """FNV-1a, 64 bits: the hash `voronoi-fit batch` puts in shared stems' folder names."""
+    h = 0xCBF29CE484222325
+    for b in data:
+        h = ((h ^ b) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+    return h
 
 
 def provenance(path: Path, options: dict) -> dict:
