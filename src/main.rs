@@ -12,6 +12,7 @@ mod cmd_delaunay;
 mod cmd_eval;
 mod cmd_fit;
 mod cmd_info;
+mod cmd_mnist;
 mod cmd_query;
 mod cmd_sample;
 mod cmd_study;
@@ -50,6 +51,8 @@ enum Command {
     /// The main job on many meshes: one folder per mesh and summary.csv; a rerun skips what
     /// finished, resumes what stopped and retries what failed.
     Batch(cmd_batch::Args),
+    /// The seed's MNIST autoencoder: encoder → Voronoi decoder (128 sites) or OccNet decoder; train, eval, tsne, interpolate.
+    Mnist(cmd_mnist::Args),
     /// Print the topology report of a mesh (counts, boundary, manifoldness, genus, volume).
     Info(cmd_info::Args),
     /// Convert a mesh to GLB, glTF, OBJ or PLY (optionally normalised into the unit cube).
@@ -92,6 +95,7 @@ fn main() {
         Command::Fit(args) => cmd_fit::run(args),
         Command::Study(args) => cmd_study::run(args),
         Command::Batch(args) => cmd_batch::run(args),
+        Command::Mnist(args) => cmd_mnist::run(args),
         Command::Info(args) => cmd_info::run(args),
         Command::Convert(args) => cmd_convert::run(args),
         Command::Sample(args) => cmd_sample::run(args),

@@ -90,6 +90,7 @@ export VF_BIN=$TARGET/ci/voronoi-fit
 export VF_ROOT=$ROOT
 export VF_NODE_DIR=$NODE_DIR
 export VF_SHARED_MESHES=${VF_SHARED_MESHES:-$ROOT/../shared/meshes}
+export VF_SHARED_MNIST=${VF_SHARED_MNIST:-$ROOT/../shared/mnist}
 if [ -x "$VENV/bin/python" ]; then
   "$VENV/bin/python" -m pytest tests/reference -q -p no:cacheprovider --junitxml="$LOG/pytest.xml" 2>&1 | tee "$LOG/pytest.log"
   py_rc=${PIPESTATUS[0]}

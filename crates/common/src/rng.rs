@@ -36,6 +36,14 @@ pub enum Stream {
     StudySphereData = 301,
     /// study: the sphere's Chamfer samples.
     StudyChamfer = 302,
+    /// mnist: the networks' weight initialisation.
+    MnistInit = 401,
+    /// mnist: the order of the training images in each epoch.
+    MnistShuffle = 402,
+    /// mnist: the training points of each image in each epoch (shared by every method).
+    MnistPoints = 403,
+    /// mnist: the tSNE's initial embedding.
+    MnistTsne = 404,
     /// baselines: the MLP's batch order.
     MlpBatch = 0x0BA7_C4E5,
     /// baselines: the MLP's weight initialisation.
@@ -205,6 +213,10 @@ mod tests {
             SelectionSurface,
             StudySphereData,
             StudyChamfer,
+            MnistInit,
+            MnistShuffle,
+            MnistPoints,
+            MnistTsne,
             MlpBatch,
             MlpInit,
             DelaunayInsertion,

@@ -22,6 +22,9 @@ pub enum CrustError {
     /// precision cannot hold it ([`crate::output::finalize`]).
     #[error("the crust cannot be written in the output's frame and precision: {0}")]
     Unwritable(String),
+    /// Planar sites that cannot make a diagram ([`crate::planar::planar_diagram`]).
+    #[error("planar sites: {0}")]
+    Planar(String),
     /// A guarantee failed to hold: a bug, reported rather than written out.
     #[error("internal error, the crust would not be valid: {0}")]
     Internal(String),

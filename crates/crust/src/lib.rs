@@ -21,6 +21,7 @@ mod error;
 mod extract;
 mod manifold;
 pub mod output;
+pub mod planar;
 mod resolve;
 mod sites_file;
 

@@ -30,6 +30,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod drawing;
 mod layout;
 mod raster;
 pub mod raster3d;
@@ -38,6 +39,7 @@ pub mod ticks;
 
 use std::path::Path;
 
+pub use drawing::{Anchor, Drawing, Shape, TextSize};
 pub use ticks::{linear_ticks, log_ticks, Ticks};
 
 /// Default picture width in pixels (SVG user units and PNG pixels).

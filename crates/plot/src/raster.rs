@@ -16,7 +16,7 @@ use crate::ticks::Label;
 use crate::{Marker, PlotError, Rgb};
 
 /// Supersampling factor of the shape pass.
-const S: f64 = 2.0;
+pub(crate) const S: f64 = 2.0;
 const WHITE: Rgb888 = Rgb888::new(255, 255, 255);
 const BLACK: Rgb888 = Rgb888::new(0, 0, 0);
 const GRID_MAJOR: Rgb888 = Rgb888::new(0xcc, 0xcc, 0xcc);
@@ -29,18 +29,18 @@ fn rgb(c: Rgb) -> Rgb888 {
 }
 
 /// An RGB8 framebuffer; drawing outside it is ignored.
-struct Canvas {
-    w: u32,
-    h: u32,
-    px: Vec<u8>,
+pub(crate) struct Canvas {
+    pub(crate) w: u32,
+    pub(crate) h: u32,
+    pub(crate) px: Vec<u8>,
 }
 
 impl Canvas {
-    fn new(w: u32, h: u32) -> Canvas {
+    pub(crate) fn new(w: u32, h: u32) -> Canvas {
         Canvas { w, h, px: vec![255; w as usize * h as usize * 3] }
     }
 
-    fn set(&mut self, x: i32, y: i32, c: Rgb888) {
+    pub(crate) fn set(&mut self, x: i32, y: i32, c: Rgb888) {
         if x >= 0 && y >= 0 && (x as u32) < self.w && (y as u32) < self.h {
             let i = (y as usize * self.w as usize + x as usize) * 3;
             self.px[i..i + 3].copy_from_slice(&[c.r(), c.g(), c.b()]);
@@ -59,7 +59,7 @@ impl Canvas {
     }
 
     /// Average `k`×`k` blocks.
-    fn downsample(&self, k: u32) -> Canvas {
+    pub(crate) fn downsample(&self, k: u32) -> Canvas {
         let (w, h) = (self.w / k, self.h / k);
         let mut out = Canvas::new(w, h);
         let n = k * k;
@@ -155,17 +155,23 @@ fn frame(c: &mut Canvas, r: Rect, color: Rgb888) {
     vline(c, r.x1, r.y0, r.y1, color);
 }
 
-fn stroke<D: DrawTarget<Color = Rgb888>>(d: &mut D, a: (f64, f64), b: (f64, f64), width: f64, color: Rgb888) {
+pub(crate) fn stroke<D: DrawTarget<Color = Rgb888>>(
+    d: &mut D,
+    a: (f64, f64),
+    b: (f64, f64),
+    width: f64,
+    color: Rgb888,
+) {
     let w = (width * S).round().max(1.0) as u32;
     let _ = Line::new(pt(a.0, a.1), pt(b.0, b.1)).into_styled(PrimitiveStyle::with_stroke(color, w)).draw(d);
 }
 
-fn disc<D: DrawTarget<Color = Rgb888>>(d: &mut D, x: f64, y: f64, radius: f64, color: Rgb888) {
+pub(crate) fn disc<D: DrawTarget<Color = Rgb888>>(d: &mut D, x: f64, y: f64, radius: f64, color: Rgb888) {
     let diameter = (2.0 * radius * S).round().max(1.0) as u32;
     let _ = Circle::with_center(pt(x, y), diameter).into_styled(PrimitiveStyle::with_fill(color)).draw(d);
 }
 
-fn polygon<D: DrawTarget<Color = Rgb888>>(d: &mut D, pts: &[(f64, f64)], color: Rgb888) {
+pub(crate) fn polygon<D: DrawTarget<Color = Rgb888>>(d: &mut D, pts: &[(f64, f64)], color: Rgb888) {
     let style = PrimitiveStyle::with_fill(color);
     for i in 1..pts.len().saturating_sub(1) {
         let (a, b, c) = (pts[0], pts[i], pts[i + 1]);
@@ -174,7 +180,7 @@ fn polygon<D: DrawTarget<Color = Rgb888>>(d: &mut D, pts: &[(f64, f64)], color: 
 }
 
 /// A polyline with round joins.
-fn polyline<D: DrawTarget<Color = Rgb888>>(d: &mut D, run: &[(f64, f64)], width: f64, color: Rgb888) {
+pub(crate) fn polyline<D: DrawTarget<Color = Rgb888>>(d: &mut D, run: &[(f64, f64)], width: f64, color: Rgb888) {
     for seg in run.windows(2) {
         stroke(d, seg[0], seg[1], width, color);
     }
@@ -215,7 +221,7 @@ fn marker<D: DrawTarget<Color = Rgb888>>(d: &mut D, m: Marker, cx: f64, cy: f64,
     }
 }
 
-fn text<D: DrawTarget<Color = Rgb888>>(
+pub(crate) fn text<D: DrawTarget<Color = Rgb888>>(
     d: &mut D,
     s: &str,
     font: &MonoFont<'_>,

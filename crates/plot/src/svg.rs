@@ -34,7 +34,7 @@ pub(crate) fn escape(s: &str) -> String {
 }
 
 /// A coordinate with two decimals, trailing zeros dropped.
-fn n(v: f64) -> String {
+pub(crate) fn n(v: f64) -> String {
     let s = format!("{v:.2}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" {

@@ -48,15 +48,17 @@ impl Kernel {
     }
 }
 
-/// A k-d tree over site positions (kiddo `ImmutableKdTree`, bucket size 32).
-pub struct SiteIndex {
-    tree: ImmutableKdTree<f64, u32, 3, 32>,
+/// A k-d tree over site positions (kiddo `ImmutableKdTree`, bucket size 32), in `D`
+/// dimensions: 3 for meshes, 2 for the MNIST autoencoder. Everything in this module is
+/// generic over `D`, so the planar experiment runs the same kernel as the main job.
+pub struct SiteIndex<const D: usize = 3> {
+    tree: ImmutableKdTree<f64, u32, D, 32>,
     num_sites: usize,
 }
 
-impl SiteIndex {
+impl<const D: usize> SiteIndex<D> {
     /// Builds the tree over `sites` (finite coordinates; at least one site).
-    pub fn new(sites: &[[f64; 3]]) -> Self {
+    pub fn new(sites: &[[f64; D]]) -> Self {
         SiteIndex { tree: ImmutableKdTree::new_from_slice(sites), num_sites: sites.len() }
     }
 
@@ -72,7 +74,7 @@ impl SiteIndex {
 
     /// Index of a nearest site to `x` and its distance (recomputed exactly in f64 from
     /// `sites`).
-    pub fn nearest(&self, sites: &[[f64; 3]], x: [f64; 3]) -> (u32, f64) {
+    pub fn nearest(&self, sites: &[[f64; D]], x: [f64; D]) -> (u32, f64) {
         let nn = self.tree.nearest_one::<SquaredEuclidean>(&x);
         (nn.item, distance(x, sites[nn.item as usize]))
     }
@@ -80,7 +82,7 @@ impl SiteIndex {
     /// Fills `out` with (site, distance) for every site within `d_min + window` of `x`,
     /// sorted by site index, and returns d_min. The distances are recomputed in f64 from
     /// `sites` so the result does not depend on the tree's internal arithmetic.
-    pub fn candidates(&self, sites: &[[f64; 3]], x: [f64; 3], window: f64, out: &mut Vec<(u32, f64)>) -> f64 {
+    pub fn candidates(&self, sites: &[[f64; D]], x: [f64; D], window: f64, out: &mut Vec<(u32, f64)>) -> f64 {
         out.clear();
         let (_, d_near) = self.nearest(sites, x);
         let radius = d_near + window;
@@ -101,10 +103,15 @@ impl SiteIndex {
     }
 }
 
+/// Euclidean distance in `D` dimensions.
 #[inline]
-pub(crate) fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+pub fn distance<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
+    let mut s = 0.0;
+    for c in 0..D {
+        let d = a[c] - b[c];
+        s += d * d;
+    }
+    s.sqrt()
 }
 
 /// Scratch space for one thread's queries.
@@ -139,12 +146,12 @@ fn value_from_candidates(
 }
 
 /// V(x) for one point.
-pub fn value(
+pub fn value<const D: usize>(
     kernel: &Kernel,
-    index: &SiteIndex,
-    sites: &[[f64; 3]],
+    index: &SiteIndex<D>,
+    sites: &[[f64; D]],
     labels: &[bool],
-    x: [f64; 3],
+    x: [f64; D],
     s: &mut Scratch,
 ) -> f64 {
     let d_min = index.candidates(sites, x, kernel.window(), &mut s.candidates);
@@ -153,14 +160,14 @@ pub fn value(
 
 /// V(x) and ∂V/∂p_k for the candidate sites k (every other site has a gradient below
 /// β·e^−τ). Calls `grad(k, ∂V/∂p_k)` for each candidate, in site order, and returns V.
-pub fn value_and_grad(
+pub fn value_and_grad<const D: usize>(
     kernel: &Kernel,
-    index: &SiteIndex,
-    sites: &[[f64; 3]],
+    index: &SiteIndex<D>,
+    sites: &[[f64; D]],
     labels: &[bool],
-    x: [f64; 3],
+    x: [f64; D],
     s: &mut Scratch,
-    mut grad: impl FnMut(u32, [f64; 3]),
+    mut grad: impl FnMut(u32, [f64; D]),
 ) -> f64 {
     let d_min = index.candidates(sites, x, kernel.window(), &mut s.candidates);
     let (v, z) = value_from_candidates(kernel, labels, &s.candidates, d_min, &mut s.weights);
@@ -175,12 +182,12 @@ pub fn value_and_grad(
         }
         let p = sites[k as usize];
         let f = -kernel.beta * coef / d;
-        grad(k, [f * (p[0] - x[0]), f * (p[1] - x[1]), f * (p[2] - x[2])]);
+        grad(k, std::array::from_fn(|c| f * (p[c] - x[c])));
     }
     v
 }
 
 /// Hard Voronoi occupancy: the label of a nearest site.
-pub fn hard_label(index: &SiteIndex, sites: &[[f64; 3]], labels: &[bool], x: [f64; 3]) -> bool {
+pub fn hard_label<const D: usize>(index: &SiteIndex<D>, sites: &[[f64; D]], labels: &[bool], x: [f64; D]) -> bool {
     labels[index.nearest(sites, x).0 as usize]
 }

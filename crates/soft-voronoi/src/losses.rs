@@ -16,19 +16,19 @@ pub const CHUNK: usize = 1024;
 ///
 /// - `sites`, `labels`: all K + B sites; `index` built over `sites`.
 /// - `points`, `occupancy`: the batch (unit-cube frame) and its ground truth.
-pub fn reconstruction(
+pub fn reconstruction<const D: usize>(
     kernel: &Kernel,
-    index: &SiteIndex,
-    sites: &[[f64; 3]],
+    index: &SiteIndex<D>,
+    sites: &[[f64; D]],
     labels: &[bool],
-    points: &[[f64; 3]],
+    points: &[[f64; D]],
     occupancy: &[bool],
     weight: f64,
-    grad: &mut [[f64; 3]],
+    grad: &mut [[f64; D]],
 ) -> f64 {
     let n = points.len().max(1) as f64;
     let trainable = grad.len() as u32;
-    let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
+    let parts: Vec<(f64, Vec<(u32, [f64; D])>)> = points
         .par_chunks(CHUNK)
         .zip(occupancy.par_chunks(CHUNK))
         .map(|(xs, os)| {
@@ -39,7 +39,7 @@ pub fn reconstruction(
                 let sign = if o { -1.0 } else { 1.0 };
                 let v = kernel::value_and_grad(kernel, index, sites, labels, x, &mut s, |k, g| {
                     if k < trainable {
-                        contributions.push((k, [sign * g[0], sign * g[1], sign * g[2]]));
+                        contributions.push((k, g.map(|gc| sign * gc)));
                     }
                 });
                 loss += if o { 1.0 - v } else { v };
@@ -53,15 +53,15 @@ pub fn reconstruction(
 /// Per-chunk partial losses and gradient contributions, summed in chunk order (so the
 /// result does not depend on the thread count); the contributions times `factor` are
 /// added into `grad`. Returns the summed loss.
-fn reduce(parts: Vec<(f64, Vec<(u32, [f64; 3])>)>, factor: f64, grad: &mut [[f64; 3]]) -> f64 {
+fn reduce<const D: usize>(parts: Vec<(f64, Vec<(u32, [f64; D])>)>, factor: f64, grad: &mut [[f64; D]]) -> f64 {
     let mut loss = 0.0;
     for (l, contributions) in parts {
         loss += l;
         for (k, g) in contributions {
             let acc = &mut grad[k as usize];
-            acc[0] += factor * g[0];
-            acc[1] += factor * g[1];
-            acc[2] += factor * g[2];
+            for c in 0..D {
+                acc[c] += factor * g[c];
+            }
         }
     }
     loss
@@ -69,10 +69,10 @@ fn reduce(parts: Vec<(f64, Vec<(u32, [f64; 3])>)>, factor: f64, grad: &mut [[f64
 
 /// Bounds loss Σ_k Σ_c max(−p_kc, 0) + max(p_kc − 1, 0) over the trainable sites (the
 /// unit cube is the domain), with its gradient times `weight` added into `grad`.
-pub fn bounds(sites: &[[f64; 3]], weight: f64, grad: &mut [[f64; 3]]) -> f64 {
+pub fn bounds<const D: usize>(sites: &[[f64; D]], weight: f64, grad: &mut [[f64; D]]) -> f64 {
     let mut loss = 0.0;
     for (p, g) in sites.iter().zip(grad.iter_mut()) {
-        for c in 0..3 {
+        for c in 0..D {
             if p[c] < 0.0 {
                 loss -= p[c];
                 g[c] -= weight;
@@ -87,11 +87,11 @@ pub fn bounds(sites: &[[f64; 3]], weight: f64, grad: &mut [[f64; 3]]) -> f64 {
 
 /// Where a point lies relative to the target solid.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Located {
+pub struct Located<const D: usize = 3> {
     /// Whether the point is inside the solid.
     pub inside: bool,
     /// A closest point on the solid's surface.
-    pub closest: [f64; 3],
+    pub closest: [f64; D],
 }
 
 /// The target shape, as needed by the signed-distance regulariser: inside test and
@@ -124,12 +124,12 @@ pub fn signed_distance(
 /// (`located`, computed at a recent position of the sites: training refreshes them every
 /// `refresh_every` steps, during which a site moves at most a few learning rates). The
 /// distance and its gradient use the current positions.
-pub fn signed_distance_cached(
-    located: &[Located],
-    sites: &[[f64; 3]],
+pub fn signed_distance_cached<const D: usize>(
+    located: &[Located<D>],
+    sites: &[[f64; D]],
     inside: &[bool],
     weight: f64,
-    grad: &mut [[f64; 3]],
+    grad: &mut [[f64; D]],
 ) -> f64 {
     let k = sites.len().max(1) as f64;
     let mut loss = 0.0;
@@ -143,7 +143,7 @@ pub fn signed_distance_cached(
         }
         loss += d;
         let f = weight / (k * d);
-        for c in 0..3 {
+        for c in 0..D {
             g[c] += f * (p[c] - loc.closest[c]);
         }
     }
@@ -191,6 +191,29 @@ impl SiteGraph {
         Ok(SiteGraph { offsets, neighbors })
     }
 
+    /// The graph with the given undirected `edges` over `num_sites` sites (each edge once
+    /// or twice, in any order; self-loops and repeats are dropped). The planar experiment
+    /// builds it from an exact 2D Delaunay triangulation.
+    pub fn from_edges(num_sites: usize, edges: impl IntoIterator<Item = (u32, u32)>) -> Self {
+        let mut rows: Vec<Vec<u32>> = vec![Vec::new(); num_sites];
+        for (a, b) in edges {
+            if a != b && (a as usize) < num_sites && (b as usize) < num_sites {
+                rows[a as usize].push(b);
+                rows[b as usize].push(a);
+            }
+        }
+        let mut offsets = Vec::with_capacity(num_sites + 1);
+        let mut neighbors = Vec::new();
+        offsets.push(0u32);
+        for mut row in rows {
+            row.sort_unstable();
+            row.dedup();
+            neighbors.extend(row);
+            offsets.push(neighbors.len() as u32);
+        }
+        SiteGraph { offsets, neighbors }
+    }
+
     /// Neighbours of site `i`.
     pub fn row(&self, i: usize) -> &[u32] {
         &self.neighbors[self.offsets[i] as usize..self.offsets[i + 1] as usize]
@@ -205,7 +228,7 @@ impl SiteGraph {
 /// Centroidal regulariser (1/K) Σ_{i trainable} ‖(L p)_i‖² with the uniform graph
 /// Laplacian (L p)_i = p_i − mean_{j ∈ N(i)} p_j of `graph`, and its gradient times
 /// `weight` added into `grad` (trainable sites only).
-pub fn centroidal(graph: &SiteGraph, sites: &[[f64; 3]], weight: f64, grad: &mut [[f64; 3]]) -> f64 {
+pub fn centroidal<const D: usize>(graph: &SiteGraph, sites: &[[f64; D]], weight: f64, grad: &mut [[f64; D]]) -> f64 {
     let trainable = grad.len();
     let k = trainable.max(1) as f64;
     let mut loss = 0.0;
@@ -217,18 +240,18 @@ pub fn centroidal(graph: &SiteGraph, sites: &[[f64; 3]], weight: f64, grad: &mut
         let inv = 1.0 / row.len() as f64;
         let mut r = sites[i];
         for &j in row {
-            for c in 0..3 {
+            for c in 0..D {
                 r[c] -= inv * sites[j as usize][c];
             }
         }
-        loss += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        loss += r.iter().map(|x| x * x).sum::<f64>();
         let f = 2.0 * weight / k;
-        for c in 0..3 {
+        for c in 0..D {
             grad[i][c] += f * r[c];
         }
         for &j in row {
             if (j as usize) < trainable {
-                for c in 0..3 {
+                for c in 0..D {
                     grad[j as usize][c] -= f * inv * r[c];
                 }
             }
