@@ -269,9 +269,7 @@ impl Drawing {
     /// [`PlotError::Size`] (checked before the file is touched) or [`PlotError::Write`].
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
         self.check_size()?;
-        let svg = self.to_svg();
-        mesh_io::atomic_write(path, |w| w.write_all(svg.as_bytes()))?;
-        Ok(())
+        crate::write_atomic(path, self.to_svg().as_bytes())
     }
 
     /// Writes [`Drawing::to_png`] to `path` atomically.
@@ -279,9 +277,7 @@ impl Drawing {
     /// # Errors
     /// As [`Drawing::to_png`] (checked before the file is touched), or [`PlotError::Write`].
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
-        let png = self.to_png()?;
-        mesh_io::atomic_write(path, |w| w.write_all(&png))?;
-        Ok(())
+        crate::write_atomic(path, &self.to_png()?)
     }
 }
 

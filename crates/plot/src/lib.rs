@@ -265,9 +265,7 @@ impl Chart {
     /// As [`Chart::validate`] (checked before the file is touched), or
     /// [`PlotError::Write`].
     pub fn write_svg(&self, path: &Path) -> Result<(), PlotError> {
-        let svg = self.try_to_svg()?;
-        mesh_io::atomic_write(path, |w| w.write_all(svg.as_bytes()))?;
-        Ok(())
+        write_atomic(path, self.try_to_svg()?.as_bytes())
     }
 
     /// Write [`Chart::to_png`] (1200×800) to `path` atomically.
@@ -275,8 +273,13 @@ impl Chart {
     /// # Errors
     /// As [`Chart::to_png`] (checked before the file is touched), or [`PlotError::Write`].
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
-        let png = self.to_png()?;
-        mesh_io::atomic_write(path, |w| w.write_all(&png))?;
-        Ok(())
+        write_atomic(path, &self.to_png()?)
     }
+}
+
+/// Writes `bytes` to `path` atomically (temporary file, then rename): every picture of
+/// this crate goes through here.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
+    mesh_io::atomic_write(path, |w| w.write_all(bytes))?;
+    Ok(())
 }

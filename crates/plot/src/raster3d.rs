@@ -154,9 +154,7 @@ impl Image {
     /// # Errors
     /// [`PlotError::Png`] (before the file is touched) or [`PlotError::Write`].
     pub fn write_png(&self, path: &Path) -> Result<(), PlotError> {
-        let png = self.to_png()?;
-        mesh_io::atomic_write(path, |w| w.write_all(&png))?;
-        Ok(())
+        crate::write_atomic(path, &self.to_png()?)
     }
 }
 
