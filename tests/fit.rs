@@ -111,6 +111,18 @@ fn interrupted_run_resumes_bit_identically() {
     assert_eq!(std::fs::read(&full).unwrap(), std::fs::read(&part).unwrap(), "crusts differ");
     let (ra, rb) = (report(&full), report(&part));
     assert_eq!(ra["losses"]["rows"], rb["losses"]["rows"]);
+    // Stopped during the polish (right after the last of the 40 training steps): the
+    // checkpoint holds the finished training and its polish settings, and the resume redoes
+    // only the polish, to the same files.
+    let late = dir.path().join("late.glb");
+    let o = fit(&m, &late, &[&QUICK[..], &["--stop-after", "40"]].concat());
+    assert_eq!(o.status.code(), Some(130), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = late.with_extension("ckpt.npz");
+    assert!(ckpt.exists() && !late.exists(), "a run stopped in the polish leaves the checkpoint and no crust");
+    let o = fit(&m, &late, &["--resume", ckpt.to_str().unwrap(), "--eval-samples", "50000"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(a == std::fs::read(late.with_extension("sites.npz")).unwrap(), "sites differ after a stop in the polish");
+    assert_eq!(report(&late)["polish"], ra["polish"]);
     // Resuming on another mesh is refused.
     let o =
         fit(&root().join("assets/icosphere.obj"), &dir.path().join("x.glb"), &["--resume", saved.to_str().unwrap()]);

@@ -32,6 +32,8 @@ pub enum Stream {
     SelectionBatch = 104,
     /// soft-voronoi: the surface samples of that batch.
     SelectionSurface = 105,
+    /// soft-voronoi: the surface batches of the polish (VoroLoss) after training.
+    PolishBatch = 106,
     /// study: the sphere's training data.
     StudySphereData = 301,
     /// study: the sphere's Chamfer samples.
@@ -211,6 +213,7 @@ mod tests {
             SurfaceBatch,
             SelectionBatch,
             SelectionSurface,
+            PolishBatch,
             StudySphereData,
             StudyChamfer,
             MnistInit,

@@ -1,6 +1,7 @@
 //! Site insertion where the crust strays: after training, at the foot c (closest input
-//! point) of every crust vertex farther than a tolerance t from the input, a mirrored pair
-//! c ± t·n (n: the normal of the input's triangle there) is inserted, labelled by the solid,
+//! point) of every crust vertex v farther than a tolerance t from the input, a mirrored pair
+//! c ± t·n (n = (v − c)/|v − c|: the triangle's normal where the foot is inside a triangle,
+//! the spike's own direction at an edge or a corner) is inserted, labelled by the solid,
 //! and the crust is extracted again, for a few rounds. A spike of crust (an inside cell
 //! poking out between outside sites at an ear tip or a corner) stands over its foot; the
 //! pair's bisector is the tangent plane at c, and the outside site is nearer to the spike
@@ -55,6 +56,7 @@ pub fn carve(
 ) -> Result<CarveReport, FitError> {
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
+    let open_edges = boundary_edges(mesh);
     // After each round's extraction: (sites so far, farthest vertex, summed excess Σ(d − t)
     // over stray vertices). Rounds need not help one by one (cutting one spike can expose
     // the next), so all of them run and the best state — least farthest vertex, then least
@@ -68,10 +70,11 @@ pub fn carve(
         let farthest = far.iter().map(|c| c.squared_distance.sqrt()).fold(0.0, f64::max);
         let excess: f64 = far.iter().map(|c| (c.squared_distance.sqrt() - tolerance).max(0.0)).sum();
         states.push((sites.len(), farthest, excess));
-        let mut stray: Vec<(f64, [f64; 3], u32)> = far
+        let mut stray: Vec<(f64, [f64; 3], [f64; 3], u32)> = far
             .iter()
-            .map(|c| (c.squared_distance.sqrt(), c.point, c.triangle))
-            .filter(|&(d, _, _)| d > tolerance)
+            .zip(&crust.mesh.positions)
+            .map(|(c, &v)| (c.squared_distance.sqrt(), c.point, v, c.triangle))
+            .filter(|&(d, _, _, _)| d > tolerance)
             .collect();
         if round == rounds || stray.is_empty() || budget < 2 {
             break;
@@ -79,15 +82,30 @@ pub fn carve(
         stray.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.map(f64::to_bits).cmp(&b.1.map(f64::to_bits))));
         let mut feet: Vec<[f64; 3]> = Vec::new();
         let mut new: Vec<[f64; 3]> = Vec::new();
-        for &(_, c, t) in &stray {
+        for &(d, c, v, t) in &stray {
             if new.len() + 2 > budget {
                 break;
             }
             if feet.iter().any(|f| dist2(*f, c) < 4.0 * tolerance * tolerance) {
                 continue;
             }
+            // A crust vertex whose foot is on the rim of a hole in the input spans the hole
+            // (the solid closes it); no site pair there can bring it nearer, and pairs along
+            // its direction would lie in the hole's plane. Measured on the scanned bunny
+            // (holes underneath): carving there lowered F-score 0.990 → 0.978.
+            if on_open_edge(mesh, t as usize, c, &open_edges, 1e-9) {
+                continue;
+            }
             feet.push(c);
-            let n = soft_voronoi::solid::unit_normal(mesh, t as usize);
+            // The pair lies along the stray vertex's own direction from its foot. Where the
+            // foot is inside a triangle that is the triangle's normal; at an edge or a
+            // corner (a spike off a plate's rim, a CAD part's corner) it is the direction the
+            // spike actually takes, which a neighbouring face's normal is not.
+            let n = if d > 0.0 {
+                [0, 1, 2].map(|i| (v[i] - c[i]) / d)
+            } else {
+                soft_voronoi::solid::unit_normal(mesh, t as usize)
+            };
             new.extend([1.0, -1.0].map(|s| [0, 1, 2].map(|i| (c[i] + s * tolerance * n[i]).clamp(1e-6, 1.0 - 1e-6))));
         }
         // Each pair is labelled by the solid, whatever it gives: at a thin tip both sites of
@@ -114,6 +132,37 @@ pub fn carve(
     sites.truncate(states[best].0);
     labels.truncate(states[best].0);
     Ok(report)
+}
+
+/// The input's edges used by exactly one triangle (the rims of holes and open parts), as
+/// sorted vertex pairs.
+fn boundary_edges(mesh: &TriMesh) -> std::collections::HashSet<(u32, u32)> {
+    let mut count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for t in &mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    count.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect()
+}
+
+/// Whether `c` (a point of triangle `t`) lies within `eps` of one of `t`'s edges that is in
+/// `open`.
+fn on_open_edge(mesh: &TriMesh, t: usize, c: [f64; 3], open: &std::collections::HashSet<(u32, u32)>, eps: f64) -> bool {
+    let tri = mesh.triangles[t];
+    (0..3).any(|k| {
+        let (a, b) = (tri[k], tri[(k + 1) % 3]);
+        if !open.contains(&(a.min(b), a.max(b))) {
+            return false;
+        }
+        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+        let e = [0, 1, 2].map(|i| pb[i] - pa[i]);
+        let w = [0, 1, 2].map(|i| c[i] - pa[i]);
+        let ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        let s = if ee > 0.0 { ((w[0] * e[0] + w[1] * e[1] + w[2] * e[2]) / ee).clamp(0.0, 1.0) } else { 0.0 };
+        dist2(c, [0, 1, 2].map(|i| pa[i] + s * e[i])) <= eps * eps
+    })
 }
 
 fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {

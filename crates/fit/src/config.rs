@@ -140,6 +140,11 @@ pub struct FitConfig {
     /// Skip the metrics against the input (Hausdorff, Chamfer, IoU): for callers that
     /// measure themselves.
     pub skip_metrics: bool,
+    /// After training, move the sites so the diagram's faces pass through the surface
+    /// samples (VoroMesh's loss, [`soft_voronoi::polish`]); before relabelling and carving.
+    /// `None`: off (`--no-polish`, and the paper preset). Not used on a thin shell, whose
+    /// sites are placed on the shell's two sides, not on the sampled surface.
+    pub polish: Option<soft_voronoi::PolishConfig>,
 }
 
 impl FitConfig {
@@ -167,6 +172,7 @@ impl FitConfig {
             carve: Some(DEFAULT_CARVE),
             refine: None,
             skip_metrics: false,
+            polish: Some(soft_voronoi::PolishConfig::default_for(num_sites, 0)),
         }
     }
 
@@ -174,6 +180,9 @@ impl FitConfig {
     pub fn with_seed(mut self, seed: u64) -> Self {
         self.sampling.seed = seed;
         self.train.seed = seed;
+        if let Some(p) = &mut self.polish {
+            p.seed = seed;
+        }
         self
     }
 
@@ -187,10 +196,34 @@ impl FitConfig {
         let sampling: Sampling = serde_json::from_str(&context).map_err(|e| {
             FitError::Input(format!("{}: not a checkpoint of `voronoi-fit MESH` ({e})", path.display()))
         })?;
+        // The polish settings of the run that wrote the checkpoint (checkpoints written
+        // before the polish existed have none: the current settings stay).
+        if let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(&context) {
+            if let Some(p) = map.get("polish") {
+                self.polish = serde_json::from_value(p.clone()).map_err(|e| {
+                    FitError::Input(format!("{}: the checkpoint's polish settings: {e}", path.display()))
+                })?;
+            }
+        }
         self.train = state.config.clone();
         self.sampling = sampling;
         self.resume = Some((state, path.display().to_string()));
         Ok(self)
+    }
+
+    /// What a checkpoint stores beside the training state: the sampling settings and the
+    /// polish settings, as one JSON object (the sampling's fields plus `polish`), so a
+    /// resume continues exactly the run that was stopped.
+    ///
+    /// # Errors
+    /// [`FitError::Failure`] when serialisation fails.
+    pub fn checkpoint_context(&self) -> Result<String, FitError> {
+        let fail = |e: serde_json::Error| FitError::Failure(format!("checkpoint settings: {e}"));
+        let mut v = serde_json::to_value(&self.sampling).map_err(fail)?;
+        if let serde_json::Value::Object(map) = &mut v {
+            map.insert("polish".into(), serde_json::to_value(&self.polish).map_err(fail)?);
+        }
+        serde_json::to_string(&v).map_err(fail)
     }
 
     /// Checks the settings.
@@ -206,6 +239,9 @@ impl FitConfig {
                 "--samples {} must be in 1000..=100000000 and at least twice --sites {}",
                 s.samples, self.train.num_sites
             )));
+        }
+        if let Some(p) = &self.polish {
+            p.validate().map_err(|e| FitError::Input(format!("{e}; see voronoi-fit --help")))?;
         }
         if self.eval.samples > 100_000_000 {
             return Err(FitError::Input(format!("--eval-samples {} must be at most 100000000", self.eval.samples)));

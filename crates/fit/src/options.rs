@@ -20,7 +20,8 @@ pub struct FitOptions {
     pub steps: Option<usize>,
     /// Seed of the samples, the initialisation and the batches.
     pub seed: u64,
-    /// `default` or `paper` (the seed paper's setting: no relabelling, no insertion).
+    /// `default` or `paper` (the seed paper's setting: no polish, no relabelling, no
+    /// insertion).
     pub preset: Option<String>,
     /// Initialisation.
     pub init: Option<Init>,
@@ -58,6 +59,12 @@ pub struct FitOptions {
     pub no_carve: bool,
     /// Skip the metrics against the input (faster; the report says so).
     pub skip_metrics: bool,
+    /// No surface polish after training (the paper preset has none either).
+    pub no_polish: bool,
+    /// Polish steps (default 400; 0 = none).
+    pub polish_steps: Option<usize>,
+    /// Polish learning rate (default 1e-3 at K = 8,192, scaled by √(8192/K)).
+    pub polish_lr: Option<f64>,
 }
 
 impl FitOptions {
@@ -77,7 +84,7 @@ impl FitOptions {
         c.sampling.solid = self.solid;
         c.sampling.shell_thickness = self.shell_thickness;
         c.train_shell = self.steps.is_some();
-        // The paper preset is the paper's method: no relabelling, no insertion.
+        // The paper preset is the paper's method: no polish, no relabelling, no insertion.
         c.relabel = !self.no_relabel && !paper;
         c.carve = if self.no_carve || (paper && self.carve.is_none()) { None } else { self.carve.or(c.carve) };
         c.eval.samples = self.eval_samples.unwrap_or(c.eval.samples);
@@ -100,6 +107,21 @@ impl FitOptions {
         t.weights.reconstruction = self.w_reconstruction.unwrap_or(t.weights.reconstruction);
         t.weights.normal = self.w_normal.unwrap_or(t.weights.normal);
         c.train = t;
+        c.polish = if self.no_polish || (paper && self.polish_steps.is_none() && self.polish_lr.is_none()) {
+            None
+        } else {
+            let mut p = soft_voronoi::PolishConfig::default_for(k, self.seed);
+            p.steps = self.polish_steps.unwrap_or(p.steps);
+            p.lr = self.polish_lr.unwrap_or(p.lr);
+            (p.steps > 0).then_some(p)
+        };
+        if c.polish.is_some() && self.no_relabel {
+            return Err(FitError::Input(
+                "--no-relabel needs --no-polish: the polish moves sites without looking at their labels, so after it \
+                 every site takes the solid's label where it stands"
+                    .into(),
+            ));
+        }
         let c = c.with_seed(self.seed);
         c.validate()?;
         Ok(c)

@@ -14,6 +14,8 @@ pub enum Stage {
     Sample,
     /// Train the sites.
     Train,
+    /// Polish the trained sites onto the surface samples.
+    Polish,
     /// Extract, check and map back the crust.
     Crust,
     /// Misclassification on fresh samples.
@@ -30,6 +32,7 @@ impl Stage {
             Stage::Oracle => "oracle",
             Stage::Sample => "sample",
             Stage::Train => "train",
+            Stage::Polish => "polish",
             Stage::Crust => "crust",
             Stage::Evaluate => "evaluate",
             Stage::Metrics => "metrics",
@@ -52,6 +55,9 @@ pub trait Progress {
     }
     /// Training ended (finished or stopped).
     fn train_end(&mut self) {}
+    /// A polish step finished: `done` of `total`, with its VoroLoss. Between steps the fit
+    /// polls [`Progress::should_stop`] too.
+    fn polish_step(&mut self, _done: usize, _total: usize, _loss: f64) {}
 }
 
 /// Progress that goes nowhere.

@@ -66,6 +66,9 @@ pub struct Timings {
     pub sample: f64,
     /// Training.
     pub train: f64,
+    /// Surface polish.
+    #[serde(default)]
+    pub polish: f64,
     /// Crust.
     pub crust: f64,
     /// Misclassification.
@@ -225,6 +228,8 @@ pub struct FitReport {
     /// Share of the pairs' candidate points refined from a previous fit (accuracy target
     /// rounds after the first), else absent.
     pub refined_share: Option<f64>,
+    /// The surface polish after training (absent when off or on a thin shell).
+    pub polish: Option<soft_voronoi::PolishReport>,
     /// Trainable sites whose label was changed to the solid's at their final position
     /// (absent when relabelling was off).
     pub relabelled_sites: Option<usize>,
@@ -271,6 +276,14 @@ impl FitReport {
             ),
             _ => String::new(),
         };
+        let polished = match &self.polish {
+            Some(p) => format!(
+                " The sites were then polished onto the surface samples ({} steps of VoroMesh's bisector loss, \
+                 {:.3e} → {:.3e}; sites moved {:.2e} rms).",
+                p.steps, p.loss_first, p.loss_last, p.move_rms
+            ),
+            None => String::new(),
+        };
         let shell = match (self.solid.half_thickness, self.solid.half_thickness_of_diagonal) {
             (Some(h), Some(f)) => format!(
                 " The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
@@ -302,7 +315,7 @@ impl FitReport {
         };
         format!(
             "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
-             misclassified ({:.3}% of uniform, {:.3}% of near-surface ones).{} Crust: {} triangles, {} component(s), \
+             misclassified ({:.3}% of uniform, {:.3}% of near-surface ones).{}{} Crust: {} triangles, {} component(s), \
              genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{} {}{}",
             self.input.path,
             t.num_sites,
@@ -318,6 +331,7 @@ impl FitReport {
             100.0 * q.misclassification,
             100.0 * q.misclassification_uniform,
             100.0 * q.misclassification_near_surface,
+            polished,
             carved,
             c.num_triangles,
             c.num_components,

@@ -139,8 +139,15 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     let trainer = train(&data, solid, initial, config, progress)?;
     timings.train = lap.next();
 
-    progress.stage(Stage::Crust);
+    progress.stage(Stage::Polish);
     let (mut sites, mut labels, num_projected) = trainer.final_sites();
+    let polish = match &config.polish {
+        Some(pc) if !target.places_sites() => Some(polish(&mut sites, &data, &trainer, pc, config, progress)?),
+        _ => None,
+    };
+    timings.polish = lap.next();
+
+    progress.stage(Stage::Crust);
     let num_relabelled =
         if config.relabel { relabel(&sites, &mut labels, trainer.config().num_sites, solid) } else { 0 };
     let carving = match config.carve {
@@ -204,6 +211,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         metrics,
         crust: crust_report(&checked, &crust_mesh, num_projected),
         refined_share,
+        polish,
         relabelled_sites: config.relabel.then_some(num_relabelled),
         carving,
         accuracy_target: None,
@@ -233,7 +241,7 @@ fn train<'a>(
         }
         .map_err(input)?,
     };
-    let context = serde_json::to_string(&config.sampling).map_err(|e| FitError::Failure(e.to_string()))?;
+    let context = config.checkpoint_context()?;
     let steps = trainer.config().steps;
     progress.train_start(trainer.state().step, steps);
     while !trainer.is_done() {
@@ -256,6 +264,39 @@ fn train<'a>(
     }
     progress.train_end();
     Ok(trainer)
+}
+
+/// Polishes the trained sites onto the surface samples ([`soft_voronoi::polish`]). A stop
+/// asked for during the polish writes the finished training's checkpoint (when
+/// checkpointing), so a resume redoes only the polish.
+fn polish(
+    sites: &mut [[f64; 3]],
+    data: &TrainingData,
+    trainer: &Trainer,
+    pc: &soft_voronoi::PolishConfig,
+    config: &FitConfig,
+    progress: &mut dyn Progress,
+) -> Result<soft_voronoi::PolishReport, FitError> {
+    let k = trainer.config().num_sites;
+    let mut stopped = false;
+    let report = soft_voronoi::polish::polish(sites, k, &data.surface, pc, |done, total, loss| {
+        progress.polish_step(done, total, loss);
+        stopped = progress.should_stop() && done < total;
+        !stopped
+    })
+    .map_err(|e| FitError::Failure(e.to_string()))?;
+    if stopped {
+        let steps = trainer.config().steps;
+        return Err(match &config.checkpointing {
+            Some(c) => {
+                let context = config.checkpoint_context()?;
+                checkpoint::write(&c.path, trainer.state(), &context).map_err(|e| FitError::Failure(e.to_string()))?;
+                FitError::Interrupted { step: steps, steps, checkpoint: c.path.clone() }
+            }
+            None => FitError::Failure(format!("stopped in the polish after {} of {} steps", report.steps, pc.steps)),
+        });
+    }
+    Ok(report)
 }
 
 /// Gives each of the first `k` (trainable) sites the solid's label at its final position and

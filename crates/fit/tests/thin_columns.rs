@@ -21,6 +21,7 @@ fn a_thin_plate_starts_with_flat_faces() {
     let mut c = FitConfig::new("plate", 2048);
     c.train.steps = 0;
     c.carve = None;
+    c.polish = None;
     c.sampling.samples = 100_000;
     c.eval.samples = 50_000;
     let out = fit::fit(&plate, &c, &mut NoProgress).unwrap();

@@ -148,6 +148,10 @@ impl Progress for PyProgress {
     fn train_step(&mut self, s: &StepStats) {
         self.call("train", s.step + 1, s.total);
     }
+    fn polish_step(&mut self, done: usize, total: usize, loss: f64) {
+        self.steps = total;
+        self.call("polish", done, loss);
+    }
     fn should_stop(&mut self) -> bool {
         self.error.is_some()
     }

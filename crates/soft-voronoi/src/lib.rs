@@ -20,6 +20,7 @@ pub mod error;
 pub mod init;
 pub mod kernel;
 pub mod losses;
+pub mod polish;
 pub mod solid;
 pub mod train;
 
@@ -27,6 +28,7 @@ pub use config::{Init, TrainConfig, Weights};
 pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};
+pub use polish::{PolishConfig, PolishReport};
 pub use solid::{MeshSolid, ShellSolid, Sphere};
 pub use train::{classify, soft_values, BestIterate, StepStats, TrainState, Trainer, TrainingData};
 pub use vf_common::AdamParams;

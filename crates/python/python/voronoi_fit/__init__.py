@@ -65,6 +65,8 @@ _FIT_OPTIONS = {
     "solid",
     "shell_thickness",
     "skip_metrics",
+    "polish_steps",
+    "polish_lr",
 }
 
 
@@ -219,11 +221,17 @@ class _Tqdm:
     def __init__(self, tqdm):
         self.tqdm = tqdm
         self.bar = None
+        self.stage = None
 
     def __call__(self, stage, step, steps, loss):
-        if stage == "train" and steps:
+        if stage in ("train", "polish") and steps:
             if self.bar is None:
-                self.bar = self.tqdm(total=steps, desc="train", unit="step", leave=False)
+                self.bar = self.tqdm(total=steps, desc=stage, unit="step", leave=False)
+                self.stage = stage
+            if self.stage != stage or self.bar.total != steps:
+                self.bar.reset(total=steps)
+                self.bar.set_description_str(stage, refresh=False)
+                self.stage = stage
             self.bar.n = step
             if loss == loss:
                 self.bar.set_postfix(loss=f"{loss:.5f}", refresh=False)
@@ -260,7 +268,8 @@ def fit(
         sites: trainable sites K.
         seed: seed of the samples, the initialisation and the batches (same seed, same
             result, on any thread count).
-        relabel: give each trained site the solid's label where it stands.
+        relabel: give each trained site the solid's label where it stands (False needs
+            polish_steps=0: the polish ignores labels).
         carve: True (default tolerance, 0.3% of the diagonal), a share of the diagonal, or
             False for no site insertion.
         progress: a callable ``progress(stage, step, steps, loss)``; None shows a tqdm bar
@@ -274,7 +283,8 @@ def fit(
         **options: the CLI's other fit options by their long names: steps, preset
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
-            solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics.
+            solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics,
+            polish_steps (0: no polish), polish_lr.
 
     Returns:
         :class:`FitResult`.

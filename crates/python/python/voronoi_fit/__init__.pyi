@@ -60,6 +60,8 @@ def fit(
     solid: Optional[str] = None,
     shell_thickness: Optional[float] = None,
     skip_metrics: Optional[bool] = None,
+    polish_steps: Optional[int] = None,
+    polish_lr: Optional[float] = None,
 ) -> FitResult: ...
 def save_mesh(path: Union[str, os.PathLike[str]], vertices: npt.ArrayLike, faces: npt.ArrayLike) -> None: ...
 def crust(

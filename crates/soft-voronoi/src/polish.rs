@@ -1,0 +1,341 @@
+//! The surface polish: after training, the sites are moved so that the Voronoi faces pass
+//! through the surface samples, with VoroMesh's loss (Maruani, Klokov, Ovsjanikov, Alliez,
+//! Desbrun, "VoroMesh: Learning Watertight Surface Meshes with Voronoi Diagrams", ICCV
+//! 2023, §4.1).
+//!
+//! For a surface sample x with nearest site p_i, VoroLoss is the squared distance from x to
+//! the boundary of p_i's cell, taken as the smallest squared distance to the bisector planes
+//! of p_i and its next-nearest sites p_j (10 of them, as in the paper's code):
+//!
+//! ```text
+//! e = p_j − p_i,  u = e/|e|,  r = x − (p_i + p_j)/2,  d_j = r·u,   loss = mean_x min_j d_j²
+//! ```
+//!
+//! The loss does not look at labels: it only pulls faces of the diagram onto the surface,
+//! and the fit labels the sites by the solid afterwards (`fit`'s relabelling). The seed's
+//! soft-Voronoi training ([`crate::Trainer`]) still runs first; the polish starts from its
+//! result. Why it is there: the soft-Voronoi losses measure occupancy, whose gradient lives
+//! within ~1/β of the crust, so they place the crust but hardly orient its faces; the
+//! bisector distance is a direct, dense signal on every face near the surface. Measured on
+//! the quality benchmark it raises normal consistency and lowers Chamfer on every mesh
+//! (README, "Surface quality").
+//!
+//! The neighbours are found with kiddo and held fixed for the gradient, as in the paper;
+//! the gradient is analytic (checked against finite differences in the tests). The run is
+//! reproducible bit for bit on any thread count: batches come from their own random stream
+//! per step, ties between equally near sites are broken by index, and the per-chunk
+//! gradients are summed in chunk order.
+
+use std::num::NonZero;
+
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use vf_common::rng::{ChunkRng, Stream};
+use vf_common::AdamParams;
+
+use crate::error::TrainError;
+
+/// Samples per parallel chunk (fixed, so the sums do not depend on the thread count).
+const CHUNK: usize = 1024;
+
+/// Settings of the polish.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PolishConfig {
+    /// Adam steps (0 = no polish).
+    pub steps: usize,
+    /// Initial learning rate in unit-cube lengths; halved after 20%, 37.5%, 50% and 62.5%
+    /// of the steps (the paper code's milestones 80, 150, 200, 250 of 400).
+    pub lr: f64,
+    /// Surface samples per step, drawn with replacement from the data's surface points.
+    pub batch: usize,
+    /// Next-nearest sites whose bisectors are considered (the paper's 10).
+    pub neighbours: usize,
+    /// Adam's constants.
+    pub adam: AdamParams,
+    /// Seed of the batches.
+    pub seed: u64,
+}
+
+impl PolishConfig {
+    /// The default for `num_sites` trainable sites: 400 steps of 20,000 samples, 10
+    /// neighbours, lr 1e-3 at K = 8,192 scaled with the surface spacing √(8192/K).
+    ///
+    /// The rate was measured on spot and featuretype from the trained default: 1e-3 gave
+    /// spot Chamfer 0.0093% and normal consistency 0.988 against 0.0121% / 0.987 at the
+    /// paper's 2.5e-3 (its 5e-3 in [−1, 1]³) and 0.0179% / 0.986 at 5e-3.
+    pub fn default_for(num_sites: usize, seed: u64) -> Self {
+        PolishConfig {
+            steps: 400,
+            lr: 1e-3 * (8192.0 / num_sites.max(1) as f64).sqrt(),
+            batch: 20_000,
+            neighbours: 10,
+            adam: AdamParams::default(),
+            seed,
+        }
+    }
+
+    /// The learning rate of 0-based step `t`.
+    pub fn lr_at(&self, t: usize) -> f64 {
+        let f = t as f64 / self.steps.max(1) as f64;
+        let halvings = [0.2, 0.375, 0.5, 0.625].iter().filter(|&&m| f >= m).count();
+        self.lr * 0.5f64.powi(halvings as i32)
+    }
+
+    /// Checks the settings; the message names the bad one.
+    ///
+    /// # Errors
+    /// [`TrainError::Config`].
+    pub fn validate(&self) -> Result<(), TrainError> {
+        let bad = |m: String| Err(TrainError::Config(m));
+        if !(self.lr.is_finite() && self.lr > 0.0) {
+            return bad(format!("polish learning rate {} must be finite and positive", self.lr));
+        }
+        if self.steps > 0 && self.batch == 0 {
+            return bad("polish batch must be at least 1".into());
+        }
+        if self.neighbours == 0 {
+            return bad("polish neighbours must be at least 1".into());
+        }
+        self.adam.validate().map_err(TrainError::Config)
+    }
+}
+
+/// What the polish did (the report's `polish` block).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PolishReport {
+    /// Steps run.
+    pub steps: usize,
+    /// Initial learning rate.
+    pub lr: f64,
+    /// Surface samples per step.
+    pub batch: usize,
+    /// VoroLoss (unit-cube lengths squared) of the first and the last batch.
+    pub loss_first: f64,
+    /// See `loss_first`.
+    pub loss_last: f64,
+    /// Root mean square and largest distance a site moved, unit-cube lengths.
+    pub move_rms: f64,
+    /// See `move_rms`.
+    pub move_max: f64,
+}
+
+/// VoroLoss of `points` against `sites` (all of them take part) and its gradient, added
+/// into `grad` for the first `grad.len()` sites (the trainable ones); returns the mean over
+/// the points. `neighbours` next-nearest sites are looked at (fewer when there are fewer).
+pub fn voroloss(sites: &[[f64; 3]], points: &[[f64; 3]], neighbours: usize, grad: &mut [[f64; 3]]) -> f64 {
+    if sites.len() < 2 || points.is_empty() {
+        return 0.0;
+    }
+    let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(sites);
+    let want = NonZero::new((neighbours + 1).min(sites.len())).expect("at least two sites");
+    let trainable = grad.len();
+    let n = points.len() as f64;
+    let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
+        .par_chunks(CHUNK)
+        .map(|xs| {
+            let mut out = Vec::with_capacity(2 * xs.len());
+            let mut near: Vec<(f64, u32)> = Vec::with_capacity(want.get());
+            let mut loss = 0.0;
+            for &x in xs {
+                near.clear();
+                for nb in tree.nearest_n::<SquaredEuclidean>(&x, want) {
+                    let p = sites[nb.item as usize];
+                    let d2 = (0..3).map(|c| (x[c] - p[c]) * (x[c] - p[c])).sum::<f64>();
+                    near.push((d2, nb.item));
+                }
+                // Exact f64 distances, ties by index: the result does not depend on the
+                // tree's internal order.
+                near.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                let i = near[0].1 as usize;
+                let pi = sites[i];
+                let mut best: Option<(f64, usize, [f64; 3], [f64; 3], f64)> = None;
+                for &(_, j) in &near[1..] {
+                    let pj = sites[j as usize];
+                    let e = [pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]];
+                    let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+                    if len == 0.0 {
+                        continue;
+                    }
+                    let u = e.map(|c| c / len);
+                    let r = [0, 1, 2].map(|c| x[c] - 0.5 * (pi[c] + pj[c]));
+                    let d = r[0] * u[0] + r[1] * u[1] + r[2] * u[2];
+                    if best.as_ref().is_none_or(|b| d * d < b.0 * b.0) {
+                        best = Some((d, j as usize, u, r, len));
+                    }
+                }
+                let Some((d, j, u, r, len)) = best else { continue };
+                loss += d * d;
+                // ∂d/∂p_j = −u/2 + t, ∂d/∂p_i = −u/2 − t, with t = (r − d u)/|e| (the turn
+                // of u); the loss takes 2d times these.
+                let t = [0, 1, 2].map(|c| (r[c] - d * u[c]) / len);
+                if i < trainable {
+                    out.push((i as u32, [0, 1, 2].map(|c| 2.0 * d * (-0.5 * u[c] - t[c]))));
+                }
+                if j < trainable {
+                    out.push((j as u32, [0, 1, 2].map(|c| 2.0 * d * (-0.5 * u[c] + t[c]))));
+                }
+            }
+            (loss, out)
+        })
+        .collect();
+    let mut loss = 0.0;
+    for (l, contributions) in parts {
+        loss += l;
+        for (k, g) in contributions {
+            for c in 0..3 {
+                grad[k as usize][c] += g[c] / n;
+            }
+        }
+    }
+    loss / n
+}
+
+/// Polishes the first `trainable` of `sites` in place (the rest, the fixed boundary sites,
+/// take part but do not move) against `surface` points, keeping them in [ε, 1 − ε]³ with
+/// ε = 1e-9 as the crust needs. `on_step(step, steps, loss)` is called after every step and
+/// returns `false` to stop early (the sites are then as after that step).
+///
+/// # Errors
+/// Invalid settings; [`TrainError::Diverged`] on a non-finite loss or site.
+pub fn polish(
+    sites: &mut [[f64; 3]],
+    trainable: usize,
+    surface: &[[f64; 3]],
+    config: &PolishConfig,
+    mut on_step: impl FnMut(usize, usize, f64) -> bool,
+) -> Result<PolishReport, TrainError> {
+    config.validate()?;
+    let trainable = trainable.min(sites.len());
+    let start: Vec<[f64; 3]> = sites[..trainable].to_vec();
+    let mut report = PolishReport {
+        steps: 0,
+        lr: config.lr,
+        batch: config.batch,
+        loss_first: f64::NAN,
+        loss_last: f64::NAN,
+        move_rms: 0.0,
+        move_max: 0.0,
+    };
+    if surface.is_empty() || trainable == 0 || sites.len() < 2 {
+        return Ok(report);
+    }
+    let (mut m, mut v) = (vec![[0.0; 3]; trainable], vec![[0.0; 3]; trainable]);
+    let mut grad = vec![[0.0; 3]; trainable];
+    let mut batch = Vec::with_capacity(config.batch);
+    const EPS: f64 = 1e-9;
+    for t in 0..config.steps {
+        let mut rng = ChunkRng::for_chunk(config.seed, Stream::PolishBatch, t as u64);
+        batch.clear();
+        batch.extend((0..config.batch).map(|_| surface[(rng.next_u64() % surface.len() as u64) as usize]));
+        grad.iter_mut().for_each(|g| *g = [0.0; 3]);
+        let loss = voroloss(sites, &batch, config.neighbours, &mut grad);
+        if !loss.is_finite() || !grad.iter().flatten().all(|g| g.is_finite()) {
+            return Err(TrainError::Diverged { step: t, what: format!("polish loss {loss}") });
+        }
+        config.adam.at::<f64>(t as u64 + 1, config.lr_at(t)).apply(
+            sites[..trainable].as_flattened_mut(),
+            grad.as_flattened(),
+            m.as_flattened_mut(),
+            v.as_flattened_mut(),
+        );
+        for p in &mut sites[..trainable] {
+            for x in p.iter_mut() {
+                *x = x.clamp(EPS, 1.0 - EPS);
+            }
+        }
+        if t == 0 {
+            report.loss_first = loss;
+        }
+        report.loss_last = loss;
+        report.steps = t + 1;
+        if !on_step(t + 1, config.steps, loss) {
+            break;
+        }
+    }
+    let moves: Vec<f64> = sites[..trainable].iter().zip(&start).map(|(a, b)| crate::kernel::distance(*a, *b)).collect();
+    report.move_rms = (moves.iter().map(|d| d * d).sum::<f64>() / moves.len() as f64).sqrt();
+    report.move_max = moves.iter().copied().fold(0.0, f64::max);
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lcg(state: &mut u64) -> f64 {
+        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The gradient against central differences, with the neighbour sets held fixed (as the
+    /// gradient is) by keeping the steps far below the gaps between distances.
+    #[test]
+    fn gradient_matches_finite_differences() {
+        let mut s = 7u64;
+        let sites: Vec<[f64; 3]> = (0..40).map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)]).collect();
+        let points: Vec<[f64; 3]> = (0..300).map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)]).collect();
+        let trainable = 30;
+        let mut grad = vec![[0.0; 3]; trainable];
+        voroloss(&sites, &points, 10, &mut grad);
+        let h = 1e-7;
+        let mut worst: f64 = 0.0;
+        for k in 0..trainable {
+            for c in 0..3 {
+                let mut plus = sites.clone();
+                plus[k][c] += h;
+                let mut minus = sites.clone();
+                minus[k][c] -= h;
+                let mut g = vec![[0.0; 3]; trainable];
+                let fd = (voroloss(&plus, &points, 10, &mut g) - voroloss(&minus, &points, 10, &mut g)) / (2.0 * h);
+                worst = worst.max((fd - grad[k][c]).abs());
+            }
+        }
+        assert!(worst < 1e-6, "largest gradient error {worst:e}");
+    }
+
+    /// Two sites mirrored across a plane: a sample on the plane has loss 0; off it, d².
+    #[test]
+    fn loss_is_the_squared_distance_to_the_bisector() {
+        let sites = [[0.5, 0.5, 0.4], [0.5, 0.5, 0.6]];
+        let mut g = vec![[0.0; 3]; 2];
+        assert_eq!(voroloss(&sites, &[[0.3, 0.7, 0.5]], 10, &mut g), 0.0);
+        let l = voroloss(&sites, &[[0.3, 0.7, 0.53]], 10, &mut g);
+        assert!((l - 0.03f64.powi(2)).abs() < 1e-15, "{l}");
+    }
+
+    /// A pair whose bisector is off the samples' plane moves onto it; the fixed site does not
+    /// move; the run is the same on one thread and on many.
+    #[test]
+    fn polish_moves_the_bisector_onto_the_surface() {
+        let mut s = 3u64;
+        let surface: Vec<[f64; 3]> =
+            (0..2000).map(|_| [0.3 + 0.4 * lcg(&mut s), 0.3 + 0.4 * lcg(&mut s), 0.5]).collect();
+        let start = vec![[0.5, 0.5, 0.45], [0.5, 0.5, 0.75], [0.02, 0.02, 0.02]];
+        let config = PolishConfig { steps: 300, lr: 2e-3, batch: 256, ..PolishConfig::default_for(2, 1) };
+        let run = |threads: usize| {
+            let mut sites = start.clone();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let r = pool.install(|| polish(&mut sites, 2, &surface, &config, |_, _, _| true)).unwrap();
+            (sites, r)
+        };
+        let (sites, report) = run(1);
+        let mid = 0.5 * (sites[0][2] + sites[1][2]);
+        assert!((mid - 0.5).abs() < 5e-3, "bisector at z = {mid}, sites {sites:?}");
+        assert!(report.loss_last < 0.05 * report.loss_first, "{report:?}");
+        assert_eq!(sites[2], start[2]);
+        assert_eq!(run(2).0, sites);
+    }
+
+    #[test]
+    fn schedule_and_validation() {
+        let c = PolishConfig::default_for(8192, 0);
+        assert_eq!(c.lr_at(0), 1e-3);
+        assert_eq!(c.lr_at(80), 5e-4);
+        assert_eq!(c.lr_at(399), 1e-3 / 16.0);
+        assert!(PolishConfig { lr: f64::NAN, ..c.clone() }.validate().is_err());
+        assert!(PolishConfig { batch: 0, ..c.clone() }.validate().is_err());
+        assert!(PolishConfig { neighbours: 0, ..c }.validate().is_err());
+    }
+}
