@@ -124,7 +124,7 @@ pub struct Args {
     #[arg(long)]
     pub no_relabel: bool,
     /// Insert mirrored pairs of sites where the crust strays farther than this share of the
-    /// diagonal from the input (`0.3%` or `0.003`), up to K/16 sites in four rounds, keeping
+    /// diagonal from the input (`0.3%` or `0.003`), up to K/8 sites in eight rounds, keeping
     /// the best round. Default 0.3% (off with --preset paper).
     #[arg(long, value_parser = parse_share)]
     pub carve: Option<f64>,

@@ -134,7 +134,7 @@ pub struct FitConfig {
     /// labels.
     pub relabel: bool,
     /// Insert sites where the crust's vertices are farther than this share of the diagonal
-    /// from the input ([`crate::carve`]; default 0.3%, up to K/16 sites in four rounds);
+    /// from the input ([`crate::carve`]; default 0.3%, up to K/8 sites in eight rounds);
     /// `None`: off.
     pub carve: Option<f64>,
     /// Skip the metrics against the input (Hausdorff, Chamfer, IoU): for callers that

@@ -154,7 +154,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         Some(c) => {
             let k = trainer.config().num_sites;
             let tolerance = c * diagonal;
-            let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, tolerance, 4, k / 16)?;
+            let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, tolerance, 8, k / 8)?;
             r.tolerance_of_diagonal = c;
             Some(r)
         }
