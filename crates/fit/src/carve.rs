@@ -56,7 +56,7 @@ pub fn carve(
 ) -> Result<CarveReport, FitError> {
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
-    let open_edges = boundary_edges(mesh);
+    let open_edges = mesh_io::topology::boundary_edges(mesh);
     // After each round's extraction: (sites so far, farthest vertex, summed excess Σ(d − t)
     // over stray vertices). Rounds need not help one by one (cutting one spike can expose
     // the next), so all of them run and the best state — least farthest vertex, then least
@@ -134,26 +134,13 @@ pub fn carve(
     Ok(report)
 }
 
-/// The input's edges used by exactly one triangle (the rims of holes and open parts), as
-/// sorted vertex pairs.
-fn boundary_edges(mesh: &TriMesh) -> std::collections::HashSet<(u32, u32)> {
-    let mut count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for t in &mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    count.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect()
-}
-
 /// Whether `c` (a point of triangle `t`) lies within `eps` of one of `t`'s edges that is in
-/// `open`.
-fn on_open_edge(mesh: &TriMesh, t: usize, c: [f64; 3], open: &std::collections::HashSet<(u32, u32)>, eps: f64) -> bool {
+/// `open` (sorted, as [`mesh_io::topology::boundary_edges`] gives them).
+fn on_open_edge(mesh: &TriMesh, t: usize, c: [f64; 3], open: &[(u32, u32)], eps: f64) -> bool {
     let tri = mesh.triangles[t];
     (0..3).any(|k| {
         let (a, b) = (tri[k], tri[(k + 1) % 3]);
-        if !open.contains(&(a.min(b), a.max(b))) {
+        if open.binary_search(&(a.min(b), a.max(b))).is_err() {
             return false;
         }
         let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);

@@ -225,6 +225,13 @@ impl EdgeSummary {
     }
 }
 
+/// The edges used by exactly one triangle (the rims of holes and open parts), as
+/// `(min, max)` vertex pairs in sorted order (search them with `binary_search`).
+pub fn boundary_edges(mesh: &TriMesh) -> Vec<(u32, u32)> {
+    let half = sorted_half_edges(mesh);
+    half.chunk_by(|x, y| x.0 == y.0 && x.1 == y.1).filter(|g| g.len() == 1).map(|g| (g[0].0, g[0].1)).collect()
+}
+
 /// Directed half-edges `(min, max, face, forward?)`, sorted by their undirected key.
 fn sorted_half_edges(mesh: &TriMesh) -> Vec<(u32, u32, u32, bool)> {
     let mut half: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(3 * mesh.triangles.len());
@@ -315,4 +322,20 @@ fn volume_and_area(mesh: &TriMesh, bbox_min: [f64; 3], bbox_max: [f64; 3]) -> (f
         volume += c[0] * normal_sum[0] + c[1] * normal_sum[1] + c[2] * normal_sum[2];
     }
     (volume / 6.0, area)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tetrahedron has no boundary edge; without its last face, the three edges of the
+    /// hole are the boundary, sorted.
+    #[test]
+    fn boundary_edges_are_the_rim_of_the_hole() {
+        let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let closed = TriMesh { positions, triangles: vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]] };
+        assert!(boundary_edges(&closed).is_empty());
+        let open = TriMesh { positions: closed.positions.clone(), triangles: closed.triangles[..3].to_vec() };
+        assert_eq!(boundary_edges(&open), vec![(0, 2), (0, 3), (2, 3)]);
+    }
 }
