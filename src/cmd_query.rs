@@ -16,7 +16,8 @@ pub struct Args {
     /// coordinates.
     pub points: PathBuf,
     /// Output .npz with `winding` (n,) f64, `occupancy` (n,) u8, `sdf` (n,) f64 (negative
-    /// inside), `closest` (n,3) f64, `squared_distance` (n,) f64, `triangle` (n,) u32.
+    /// inside), `closest` (n,3) f64, `squared_distance` (n,) f64, `triangle` (n,) u32, and
+    /// `winding_exact_fallbacks` (how many fast values were recomputed exactly).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Exact winding numbers (sum of all solid angles) instead of the fast approximation.
@@ -24,7 +25,7 @@ pub struct Args {
     pub exact: bool,
     /// Print compute times as one JSON line on stderr: wall seconds of the oracle build,
     /// the winding numbers and the closest points (excluding file I/O), and CPU seconds
-    /// of the last two (Linux only, else null).
+    /// of the last two (Linux only, else null), and the number of exact fallbacks.
     #[arg(long)]
     pub timings: bool,
 }
@@ -42,7 +43,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let mode = if args.exact { WindingMode::Exact } else { WindingMode::Fast };
     let t1 = Instant::now();
     let c1 = process_cpu_seconds();
-    let winding = oracle.winding_numbers(&queries, mode).in_file(&args.points)?;
+    let (winding, fallbacks) = oracle.winding_numbers_counted(&queries, mode).in_file(&args.points)?;
     let winding_s = t1.elapsed().as_secs_f64();
     let winding_cpu_s = process_cpu_seconds().zip(c1).map(|(b, a)| b - a);
     let t2 = Instant::now();
@@ -77,11 +78,12 @@ pub fn run(args: Args) -> Result<(), CliError> {
     npz.add("squared_distance", &vec_array(&sqd))?;
     npz.add("triangle", &vec_array(&tri))?;
     add_config(&mut npz, &config, args.exact)?;
+    npz.add("winding_exact_fallbacks", &ndarray::arr0(fallbacks))?;
     npz.write(&args.output)?;
     if args.timings {
         let json = |x: Option<f64>| x.map_or("null".to_string(), |v| format!("{v:.3}"));
         eprintln!(
-            "{{\"num_queries\": {}, \"num_triangles\": {}, \"threads\": {}, \"build_s\": {build_s:.6}, \"winding_s\": {winding_s:.6}, \"distance_s\": {distance_s:.6}, \"winding_cpu_s\": {}, \"distance_cpu_s\": {}}}",
+            "{{\"num_queries\": {}, \"num_triangles\": {}, \"threads\": {}, \"build_s\": {build_s:.6}, \"winding_s\": {winding_s:.6}, \"distance_s\": {distance_s:.6}, \"winding_cpu_s\": {}, \"distance_cpu_s\": {}, \"exact_fallbacks\": {fallbacks}}}",
             queries.len(),
             oracle.num_triangles(),
             available_threads(),

@@ -11,7 +11,9 @@ use crate::distance::{closest_point_slot, ClosestPoint};
 use crate::order::morton_order;
 use crate::vec3::V3;
 use crate::winding::exact::{build_caps, exact_solid_angle_sum, exact_traversal_counts, Caps};
-use crate::winding::fast::{build_fast_nodes, fast_solid_angle_sum, fast_traversal_counts, FastNodes};
+use crate::winding::fast::{
+    build_fast_nodes, fast_solid_angle_sum, fast_solid_angle_sums, fast_traversal_counts, FastNodes,
+};
 use crate::winding::WindingMode;
 use crate::{OccupancyError, Workspace};
 
@@ -237,13 +239,19 @@ impl MeshOracle {
             WindingMode::Exact => self.winding_number_exact(q, ws),
             WindingMode::Fast => {
                 let w = self.winding_number_fast_unguarded(q, ws);
-                if self.config.needs_exact_fallback(w) {
-                    ws.num_exact_fallbacks += 1;
-                    self.winding_number_exact(q, ws)
-                } else {
-                    w
-                }
+                self.guard(q, w, ws)
             }
+        }
+    }
+
+    /// The exact fallback of the fast mode: `w` (a fast value at `q`) itself, or the exact
+    /// winding number when `w` is too close to the threshold to decide from.
+    fn guard(&self, q: V3, w: f64, ws: &mut Workspace) -> f64 {
+        if self.config.needs_exact_fallback(w) {
+            ws.num_exact_fallbacks += 1;
+            self.winding_number_exact(q, ws)
+        } else {
+            w
         }
     }
 
@@ -260,7 +268,7 @@ impl MeshOracle {
     /// A query that is not finite.
     pub fn inside(&self, queries: &[V3]) -> Result<Vec<bool>, OccupancyError> {
         validate_queries(queries)?;
-        Ok(self.map_coherent(queries, |q, ws| self.is_inside(q, WindingMode::Fast, ws)).0)
+        Ok(self.map_coherent_winding(queries, WindingMode::Fast, |_, w, _| self.config.is_inside_winding(w)).0)
     }
 
     /// Closest point on the mesh to `q` (exact f64 point-triangle distances, BVH
@@ -292,8 +300,21 @@ impl MeshOracle {
     /// # Errors
     /// [`OccupancyError::BadQuery`] for a non-finite or huge coordinate.
     pub fn winding_numbers(&self, queries: &[V3], mode: WindingMode) -> Result<Vec<f64>, OccupancyError> {
+        Ok(self.winding_numbers_counted(queries, mode)?.0)
+    }
+
+    /// [`MeshOracle::winding_numbers`] with the number of queries that fell in the exact
+    /// fallback band (fast mode; 0 in exact mode), for reporting the fallback share.
+    ///
+    /// # Errors
+    /// [`OccupancyError::BadQuery`] for a non-finite or huge coordinate.
+    pub fn winding_numbers_counted(
+        &self,
+        queries: &[V3],
+        mode: WindingMode,
+    ) -> Result<(Vec<f64>, u64), OccupancyError> {
         validate_queries(queries)?;
-        Ok(self.map_coherent(queries, |q, ws| self.winding_number(q, mode, ws)).0)
+        Ok(self.map_coherent_winding(queries, mode, |_, w, _| w))
     }
 
     /// Closest points of many queries (parallel, deterministic).
@@ -317,8 +338,7 @@ impl MeshOracle {
     /// [`OccupancyError::BadQuery`] for a non-finite or huge coordinate.
     pub fn query(&self, queries: &[V3], mode: WindingMode) -> Result<QueryBatch, OccupancyError> {
         validate_queries(queries)?;
-        let (rows, fallbacks) =
-            self.map_coherent(queries, |q, ws| (self.winding_number(q, mode, ws), self.closest_point(q, ws)));
+        let (rows, fallbacks) = self.map_coherent_winding(queries, mode, |q, w, ws| (w, self.closest_point(q, ws)));
         let n = queries.len();
         let mut out = QueryBatch {
             num_exact_fallbacks: fallbacks,
@@ -342,6 +362,40 @@ impl MeshOracle {
         Ok(out)
     }
 
+    /// [`MeshOracle::map_coherent`] with the winding number of each query in `mode` passed
+    /// to `f` as its second argument. In the fast mode the raw values come from the packet
+    /// traversal ([`fast_solid_angle_sums`], bit-identical to one query at a time) over each
+    /// chunk's Morton-ordered queries, then pass the exact fallback one by one.
+    fn map_coherent_winding<T, F>(&self, queries: &[V3], mode: WindingMode, f: F) -> (Vec<T>, u64)
+    where
+        T: Send + Copy + Default,
+        F: Fn(V3, f64, &mut Workspace) -> T + Sync,
+    {
+        match mode {
+            WindingMode::Exact => self.map_coherent_chunks(queries, |idx, ws| {
+                idx.iter()
+                    .map(|&i| {
+                        let q = queries[i as usize];
+                        let w = self.winding_number_exact(q, ws);
+                        f(q, w, ws)
+                    })
+                    .collect()
+            }),
+            WindingMode::Fast => self.map_coherent_chunks(queries, |idx, ws| {
+                let pts: Vec<V3> = idx.iter().map(|&i| queries[i as usize]).collect();
+                let mut raw = vec![0.0; pts.len()];
+                fast_solid_angle_sums(&self.bvh, &self.fast, &pts, &mut raw, &mut ws.packets);
+                pts.iter()
+                    .zip(raw)
+                    .map(|(&q, r)| {
+                        let w = self.guard(q, r * INV_FOUR_PI, ws);
+                        f(q, w, ws)
+                    })
+                    .collect()
+            }),
+        }
+    }
+
     /// Applies `f` to every query in Morton order, in fixed chunks of [`QUERY_CHUNK`]
     /// processed in parallel with one fresh workspace state per chunk, and returns the
     /// results in input order with the number of exact fallbacks. The output does not
@@ -351,13 +405,23 @@ impl MeshOracle {
         T: Send + Copy + Default,
         F: Fn(V3, &mut Workspace) -> T + Sync,
     {
+        self.map_coherent_chunks(queries, |idx, ws| idx.iter().map(|&i| f(queries[i as usize], ws)).collect())
+    }
+
+    /// The chunking of [`MeshOracle::map_coherent`]: `f` maps one chunk of Morton-ordered
+    /// query indices to its results.
+    fn map_coherent_chunks<T, F>(&self, queries: &[V3], f: F) -> (Vec<T>, u64)
+    where
+        T: Send + Copy + Default,
+        F: Fn(&[u32], &mut Workspace) -> Vec<T> + Sync,
+    {
         let order = morton_order(queries);
         let (sorted, fallbacks): (Vec<Vec<T>>, Vec<u64>) = order
             .par_chunks(QUERY_CHUNK)
             .map_init(Workspace::new, |ws, idx| {
                 ws.last_slot = None;
                 let before = ws.num_exact_fallbacks;
-                let v: Vec<T> = idx.iter().map(|&i| f(queries[i as usize], ws)).collect();
+                let v = f(idx, ws);
                 (v, ws.num_exact_fallbacks - before)
             })
             .unzip();

@@ -7,6 +7,8 @@
 pub struct Workspace {
     /// Node stack of the winding-number traversals.
     pub(crate) nodes: Vec<u32>,
+    /// (node, lane mask) stack of the packet traversal of the fast winding number.
+    pub(crate) packets: Vec<(u32, crate::winding::fast::LaneMask)>,
     /// (node, squared box distance) stack of the closest-point traversal.
     pub(crate) nodes_with_bound: Vec<(u32, f64)>,
     /// Number of fast winding queries recomputed exactly because they fell within
@@ -23,6 +25,7 @@ impl Workspace {
     pub fn new() -> Self {
         Workspace {
             nodes: Vec::with_capacity(128),
+            packets: Vec::with_capacity(128),
             nodes_with_bound: Vec::with_capacity(128),
             num_exact_fallbacks: 0,
             last_slot: None,

@@ -18,8 +18,13 @@ pub struct MeshSolid<'a> {
 }
 
 impl Solid for MeshSolid<'_> {
-    /// Inside test for each point ([`MeshOracle::is_inside`]).
+    /// Inside test for each point ([`MeshOracle::is_inside`]), through the oracle's batch
+    /// [`MeshOracle::inside`] (Morton order, packet traversal: the same answers, several
+    /// times faster); points it refuses (non-finite coordinates) are tested one by one.
     fn inside(&self, points: &[[f64; 3]]) -> Vec<bool> {
+        if let Ok(v) = self.oracle.inside(points) {
+            return v;
+        }
         let mut out = vec![false; points.len()];
         out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(o, ps)| {
             let mut ws = Workspace::new();
@@ -30,16 +35,21 @@ impl Solid for MeshSolid<'_> {
         out
     }
 
+    /// Inside test as [`MeshSolid::inside`]; closest points one chunk of [`CHUNK`] at a
+    /// time in input order (each chunk's search starts afresh, so the points found never
+    /// depend on the thread count).
     fn locate(&self, points: &[[f64; 3]]) -> Vec<Located> {
+        let inside = self.inside(points);
         let mut out = vec![Located { inside: false, closest: [0.0; 3] }; points.len()];
-        out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).for_each(|(o, ps)| {
-            let mut ws = Workspace::new();
-            for (o, &p) in o.iter_mut().zip(ps) {
-                let inside = self.oracle.is_inside(p, WindingMode::Fast, &mut ws);
-                let closest = self.oracle.closest_point(p, &mut ws).point;
-                *o = Located { inside, closest };
-            }
-        });
+        out.par_chunks_mut(CHUNK).zip(points.par_chunks(CHUNK)).zip(inside.par_chunks(CHUNK)).for_each(
+            |((o, ps), ins)| {
+                let mut ws = Workspace::new();
+                for ((o, &p), &inside) in o.iter_mut().zip(ps).zip(ins) {
+                    let closest = self.oracle.closest_point(p, &mut ws).point;
+                    *o = Located { inside, closest };
+                }
+            },
+        );
         out
     }
 }

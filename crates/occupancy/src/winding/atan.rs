@@ -63,9 +63,99 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     }
 }
 
+/// [`atan2`] of `N` pairs at once, bit-identical to calling it on each pair: the same
+/// operations as [`atan_nonneg`], with every branch computed and the result selected, so the
+/// loop vectorises. Lanes outside the fast path (a zero or non-finite `x`, a non-finite `y`)
+/// are recomputed one by one with [`atan2`].
+#[inline(always)]
+pub fn atan2_lanes<const N: usize>(y: &[f64; N], x: &[f64; N]) -> [f64; N] {
+    let mut out = [0.0; N];
+    let mut special = false;
+    for i in 0..N {
+        let (yi, xi) = (y[i], x[i]);
+        special |= !(xi.is_finite() && yi.is_finite()) || xi == 0.0;
+        let t = (yi / xi).abs();
+        let big = t > T3P8;
+        let small = t <= 0.66;
+        let inv = -1.0 / t;
+        let mobius = (t - 1.0) / (t + 1.0);
+        let base = if big {
+            FRAC_PI_2
+        } else if small {
+            0.0
+        } else {
+            FRAC_PI_4
+        };
+        let xr = if big {
+            inv
+        } else if small {
+            t
+        } else {
+            mobius
+        };
+        let more = if big {
+            MOREBITS
+        } else if small {
+            0.0
+        } else {
+            0.5 * MOREBITS
+        };
+        let z = xr * xr;
+        let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+        let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+        let r = xr * (z * p / q) + xr;
+        let a = base + (r + more);
+        let a = if xi < 0.0 { PI - a } else { a };
+        out[i] = if yi.is_sign_negative() { -a } else { a };
+    }
+    if special {
+        for i in 0..N {
+            if !(x[i].is_finite() && y[i].is_finite()) || x[i] == 0.0 {
+                out[i] = atan2(y[i], x[i]);
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lanes_equal_one_at_a_time_bit_for_bit() {
+        let mut state = 987654321u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 4.0
+        };
+        let specials = [0.0, -0.0, 1.0, -1.0, 0.66, T3P8, f64::INFINITY, f64::NAN, 1e-300, 1e300];
+        for round in 0..20_000 {
+            let mut y = [0.0; 8];
+            let mut x = [0.0; 8];
+            for i in 0..8 {
+                let scale = 10f64.powi((round + i) as i32 % 13 - 6);
+                y[i] = next() * scale;
+                x[i] = next();
+                if round % 7 == 0 && i % 3 == 0 {
+                    x[i] = specials[(round / 7 + i) % specials.len()];
+                }
+                if round % 11 == 0 && i % 4 == 1 {
+                    y[i] = specials[(round / 11 + i) % specials.len()];
+                }
+            }
+            let lanes = atan2_lanes(&y, &x);
+            for i in 0..8 {
+                let one = atan2(y[i], x[i]);
+                assert!(
+                    lanes[i].to_bits() == one.to_bits() || (lanes[i].is_nan() && one.is_nan()),
+                    "{} {}",
+                    y[i],
+                    x[i]
+                );
+            }
+        }
+    }
 
     #[test]
     fn agrees_with_libm_everywhere() {

@@ -18,7 +18,7 @@
 
 use rayon::prelude::*;
 
-use super::solid_angle::solid_angle;
+use super::solid_angle::{solid_angle, solid_angle_lanes};
 use crate::bvh::TriangleBvh;
 use crate::vec3::{add, cross, dot, scale, sub, V3};
 
@@ -304,6 +304,163 @@ pub(crate) fn fast_solid_angle_sum(bvh: &TriangleBvh, nodes: &FastNodes, q: V3, 
         }
     }
     sum
+}
+
+/// Queries per packet of [`fast_solid_angle_sums`]. Measured single-threaded on the
+/// bunny and a 20,480-face icosphere (200k issue queries): 8 lanes 3.5 µs/query, 16 lanes
+/// 2.9, 32 lanes 3.5–4.2 (the packets' union of visited nodes grows).
+pub(crate) const LANES: usize = 16;
+
+/// One bit per lane of a packet.
+pub(crate) type LaneMask = u16;
+
+/// [`fast_solid_angle_sum`] for many queries, traversed in packets of [`LANES`]
+/// consecutive queries (callers pass them in a spatially coherent order, e.g. Morton).
+///
+/// A packet walks the tree once with a lane mask: at each node the acceptance test runs
+/// for all lanes at once, the expansion is evaluated for every lane that accepts it (all
+/// lanes in one vectorisable loop when several do), and the children are visited only by
+/// the lanes that did not. Nearby queries accept and open mostly the same nodes, so each
+/// node's 40-byte record and 192-byte moments are loaded once per packet instead of once
+/// per query, and the acceptance branch becomes a mask test. Every lane adds exactly the
+/// terms [`fast_solid_angle_sum`] adds for its query, in the same order and with the same
+/// arithmetic, so the results are bit-identical to the one-query traversal (tested).
+///
+/// - `qs`: #Q query points, mesh frame.
+/// - `out`: #Q results (4π times the winding number).
+/// - `stack`: reusable traversal stack of (node, lane mask).
+pub(crate) fn fast_solid_angle_sums(
+    bvh: &TriangleBvh,
+    nodes: &FastNodes,
+    qs: &[V3],
+    out: &mut [f64],
+    stack: &mut Vec<(u32, LaneMask)>,
+) {
+    debug_assert_eq!(qs.len(), out.len());
+    #[cfg(target_arch = "x86_64")]
+    {
+        if avx2_available() {
+            for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+                // SAFETY: the CPU supports AVX2 (checked at run time). AVX2 changes only
+                // the vector width: IEEE operations round lane by lane exactly as with
+                // SSE2, and no fused multiply-add is enabled, so the bits are the same.
+                unsafe { packet_avx2(bvh, nodes, q, o, stack) };
+            }
+            return;
+        }
+    }
+    for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+        packet(bvh, nodes, q, o, stack);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn avx2_available() -> bool {
+    use std::sync::OnceLock;
+    static AVX2: OnceLock<bool> = OnceLock::new();
+    *AVX2.get_or_init(|| std::arch::is_x86_feature_detected!("avx2"))
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn packet_avx2(
+    bvh: &TriangleBvh,
+    nodes: &FastNodes,
+    qs: &[V3],
+    out: &mut [f64],
+    stack: &mut Vec<(u32, LaneMask)>,
+) {
+    packet(bvh, nodes, qs, out, stack)
+}
+
+/// One packet of at most [`LANES`] queries (see [`fast_solid_angle_sums`]).
+#[inline(always)]
+fn packet(bvh: &TriangleBvh, nodes: &FastNodes, qs: &[V3], out: &mut [f64], stack: &mut Vec<(u32, LaneMask)>) {
+    let hot = &nodes.hot[..];
+    let moments = &nodes.moments[..];
+    let corners = &bvh.corners[..];
+    let n = qs.len().min(LANES);
+    if n == 0 {
+        return;
+    }
+    // Unused lanes repeat the first query and are masked off.
+    let mut qx = [qs[0][0]; LANES];
+    let mut qy = [qs[0][1]; LANES];
+    let mut qz = [qs[0][2]; LANES];
+    for (i, q) in qs.iter().enumerate().take(n) {
+        qx[i] = q[0];
+        qy[i] = q[1];
+        qz[i] = q[2];
+    }
+    let all: LaneMask = if n == LANES { LaneMask::MAX } else { (1 << n) - 1 };
+    let mut sum = [0.0f64; LANES];
+    stack.clear();
+    stack.push((0, all));
+    while let Some((node, mask)) = stack.pop() {
+        let h = &hot[node as usize];
+        let cf = h.center_far;
+        let mut rx = [0.0; LANES];
+        let mut ry = [0.0; LANES];
+        let mut rz = [0.0; LANES];
+        let mut rho2 = [0.0; LANES];
+        let mut far: LaneMask = 0;
+        for i in 0..LANES {
+            rx[i] = cf[0] - qx[i];
+            ry[i] = cf[1] - qy[i];
+            rz[i] = cf[2] - qz[i];
+            rho2[i] = rx[i] * rx[i] + ry[i] * ry[i] + rz[i] * rz[i];
+            far |= ((rho2[i] > cf[3]) as LaneMask) << i;
+        }
+        far &= mask;
+        if far != 0 {
+            let m = &moments[node as usize];
+            if far.count_ones() >= 3 {
+                // All lanes in one loop; lanes that did not accept add nothing (their
+                // value may be inf or NaN at ρ = 0, so it is selected away, not scaled).
+                for i in 0..LANES {
+                    let v = m.eval([rx[i], ry[i], rz[i]], rho2[i]);
+                    sum[i] += if far >> i & 1 == 1 { v } else { 0.0 };
+                }
+            } else {
+                let mut bits = far;
+                while bits != 0 {
+                    let i = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    sum[i] += m.eval([rx[i], ry[i], rz[i]], rho2[i]);
+                }
+            }
+        }
+        let near = mask & !far;
+        if near == 0 {
+            continue;
+        }
+        if h.link[1] != u32::MAX {
+            let tris = &corners[h.link[0] as usize..h.link[1] as usize];
+            if near.count_ones() >= 3 {
+                for t in tris {
+                    let w = solid_angle_lanes(&qx, &qy, &qz, t[0], t[1], t[2]);
+                    for i in 0..LANES {
+                        sum[i] += if near >> i & 1 == 1 { w[i] } else { 0.0 };
+                    }
+                }
+                continue;
+            }
+            let mut bits = near;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let q = [qx[i], qy[i], qz[i]];
+                for t in tris {
+                    sum[i] += solid_angle(q, t[0], t[1], t[2]);
+                }
+            }
+        } else {
+            let l = h.link[0];
+            stack.push((l + 1, near));
+            stack.push((l, near));
+        }
+    }
+    out[..n].copy_from_slice(&sum[..n]);
 }
 
 /// Work done by one fast query: (nodes visited, expansions evaluated, exact triangles).
