@@ -30,16 +30,50 @@ const T3P8: f64 = 2.414_213_562_373_095_048_80;
 /// Low bits of π/2 beyond f64 (π/2 − FRAC_PI_2).
 const MOREBITS: f64 = 6.123_233_995_736_765_886_130E-17;
 
-/// atan(x) for x ≥ 0.
+/// atan(ay / ax) for finite `ay ≥ 0` and `ax > 0`. Cephes' three ranges (t ≤ 0.66,
+/// 0.66 < t ≤ tan(3π/8), beyond) are told apart by comparing `ay` with multiples of `ax`,
+/// and the reduced argument (t, (t − 1)/(t + 1) or −1/t) is formed from `ay` and `ax` with
+/// one division instead of two (t itself is never rounded). Every range is computed by the
+/// same expressions and the result selected, so [`atan2_lanes`] vectorises this code and
+/// agrees with [`atan2`] bit for bit (tested).
 #[inline(always)]
-fn atan_nonneg(x: f64) -> f64 {
-    let (base, x, more) = if x > T3P8 {
-        (FRAC_PI_2, -1.0 / x, MOREBITS)
-    } else if x <= 0.66 {
-        (0.0, x, 0.0)
+fn atan_ratio(ay: f64, ax: f64) -> f64 {
+    let big = ay > T3P8 * ax;
+    let small = ay <= 0.66 * ax;
+    let num = if big {
+        -ax
+    } else if small {
+        ay
     } else {
-        (FRAC_PI_4, (x - 1.0) / (x + 1.0), 0.5 * MOREBITS)
+        ay - ax
     };
+    let den = if big {
+        ay
+    } else if small {
+        ax
+    } else {
+        ay + ax
+    };
+    let base = if big {
+        FRAC_PI_2
+    } else if small {
+        0.0
+    } else {
+        FRAC_PI_4
+    };
+    let more = if big {
+        MOREBITS
+    } else if small {
+        0.0
+    } else {
+        0.5 * MOREBITS
+    };
+    atan_reduced(num / den, base, more)
+}
+
+/// `base + atan(x)` for a reduced argument `|x| ≤ 0.66` (`more`: low bits of `base`).
+#[inline(always)]
+fn atan_reduced(x: f64, base: f64, more: f64) -> f64 {
     let z = x * x;
     let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
     let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
@@ -54,7 +88,7 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     if !(x.is_finite() && y.is_finite()) || x == 0.0 {
         return y.atan2(x);
     }
-    let a = atan_nonneg((y / x).abs());
+    let a = atan_ratio(y.abs(), x.abs());
     let a = if x < 0.0 { PI - a } else { a };
     if y.is_sign_negative() {
         -a
@@ -63,9 +97,8 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     }
 }
 
-/// [`atan2`] of `N` pairs at once, bit-identical to calling it on each pair: the same
-/// operations as [`atan_nonneg`], with every branch computed and the result selected, so the
-/// loop vectorises. Lanes outside the fast path (a zero or non-finite `x`, a non-finite `y`)
+/// [`atan2`] of `N` pairs at once, bit-identical to calling it on each pair (both run
+/// [`atan_ratio`], whose ranges are selected, not branched, so the loop vectorises). Lanes outside the fast path (a zero or non-finite `x`, a non-finite `y`)
 /// are recomputed one by one with [`atan2`].
 #[inline(always)]
 pub fn atan2_lanes<const N: usize>(y: &[f64; N], x: &[f64; N]) -> [f64; N] {
@@ -74,37 +107,7 @@ pub fn atan2_lanes<const N: usize>(y: &[f64; N], x: &[f64; N]) -> [f64; N] {
     for i in 0..N {
         let (yi, xi) = (y[i], x[i]);
         special |= !(xi.is_finite() && yi.is_finite()) || xi == 0.0;
-        let t = (yi / xi).abs();
-        let big = t > T3P8;
-        let small = t <= 0.66;
-        let inv = -1.0 / t;
-        let mobius = (t - 1.0) / (t + 1.0);
-        let base = if big {
-            FRAC_PI_2
-        } else if small {
-            0.0
-        } else {
-            FRAC_PI_4
-        };
-        let xr = if big {
-            inv
-        } else if small {
-            t
-        } else {
-            mobius
-        };
-        let more = if big {
-            MOREBITS
-        } else if small {
-            0.0
-        } else {
-            0.5 * MOREBITS
-        };
-        let z = xr * xr;
-        let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
-        let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
-        let r = xr * (z * p / q) + xr;
-        let a = base + (r + more);
+        let a = atan_ratio(yi.abs(), xi.abs());
         let a = if xi < 0.0 { PI - a } else { a };
         out[i] = if yi.is_sign_negative() { -a } else { a };
     }

@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""Stage times of the main job (`voronoi-fit MESH -o OUT`, default settings) on every mesh
+in ../shared/meshes and assets/bunny.obj, optionally beside a baseline binary run on the
+same meshes in the same session, with the ratio per stage.
+
+    python3 benches/main_job_times.py [--bin target/release/voronoi-fit]
+                                      [--baseline OLD_BINARY] [--meshes a.obj,b.glb]
+                                      [--json OUT.json]
+
+Build the binary first (`cargo build --release --bin voronoi-fit`); a baseline is any
+other build of it (for instance an older commit built in a git worktree). Stage times are
+the report's `timings_seconds` (wall seconds on every core); the misclassification is the
+report's, on its fresh evaluation samples, so a speed-up that changes the fit shows there.
+Only the standard library is needed.
+"""
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared" / "meshes"
+STAGES = ["sample", "train", "polish", "crust", "evaluate", "metrics"]
+
+
+def run(binary, mesh, out_dir):
+    out = out_dir / (mesh.stem + ".glb")
+    r = subprocess.run([str(binary), str(mesh), "-o", str(out), "--quiet"], capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"{binary} failed on {mesh}: {r.stderr.strip()}")
+    report = json.loads(out.with_suffix(".report.json").read_text())
+    t = report["timings_seconds"]
+    return {
+        "total": report["total_seconds"],
+        "stages": {s: t.get(s, 0.0) for s in STAGES},
+        "misclassification": report["quality"]["misclassification"],
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default=str(ROOT / "target" / "release" / "voronoi-fit"))
+    ap.add_argument("--baseline", help="another voronoi-fit binary to time on the same meshes")
+    ap.add_argument("--meshes", help="comma-separated mesh paths (default: ../shared/meshes/* and assets/bunny.obj)")
+    ap.add_argument("--json", help="write the measurements here")
+    a = ap.parse_args()
+    if a.meshes:
+        meshes = [Path(m) for m in a.meshes.split(",")]
+    else:
+        meshes = sorted(p for p in SHARED.iterdir() if p.suffix.lower() != ".md") + [ROOT / "assets" / "bunny.obj"]
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        for mesh in meshes:
+            row = {"mesh": mesh.name, "new": run(a.bin, mesh, tmp)}
+            if a.baseline:
+                row["baseline"] = run(a.baseline, mesh, tmp)
+            rows.append(row)
+            print(f"{mesh.name}: {row['new']['total']:.1f} s", file=sys.stderr)
+    head = "| mesh | total s | " + " | ".join(f"{s} s" for s in STAGES) + " | misclassified |"
+    print(head)
+    print("|" + "---|" * (len(STAGES) + 3))
+    for r in rows:
+        n = r["new"]
+        b = r.get("baseline")
+
+        def cell(new, old):
+            return f"{new:.1f}" if old is None else f"{new:.1f} ({old / max(new, 1e-9):.1f}×)"
+
+        cells = [cell(n["total"], b and b["total"])]
+        cells += [cell(n["stages"][s], b and b["stages"][s]) for s in STAGES]
+        mis = f"{100 * n['misclassification']:.3f}%"
+        if b:
+            mis += f" (was {100 * b['misclassification']:.3f}%)"
+        print(f"| {r['mesh']} | " + " | ".join(cells) + f" | {mis} |")
+    if a.baseline:
+        print("\nIn parentheses: baseline time / new time (> 1: faster now).")
+    if a.json:
+        Path(a.json).write_text(json.dumps(rows, indent=1))
+
+
+if __name__ == "__main__":
+    main()

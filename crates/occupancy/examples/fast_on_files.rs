@@ -1,0 +1,58 @@
+//! The fast winding number on any mesh files (read with mesh-io): max error against the
+//! exact one, queries above 1e-3, inside/outside flips, the share of queries the exact
+//! fallback band recomputes, work per query and time, on the issue's query sets (half
+//! uniform in the box grown 10%, half surface samples + N(0, (1% diag)²)):
+//!
+//! `cargo run --release -p occupancy --example fast_on_files -- N MESH...`
+//!
+//! Exact values are cached in /tmp (`exact_STEM_#V_#F_N.bin`) between runs.
+use occupancy::{Config, MeshOracle, WindingMode};
+#[path = "../tests/common/mod.rs"]
+mod common;
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let n: usize = args[1].parse().unwrap();
+    for path in &args[2..] {
+        let m = mesh_io::read_mesh(std::path::Path::new(path)).unwrap();
+        let mesh = (m.positions.clone(), m.triangles.clone());
+        let queries = common::issue_queries(&mesh, n, 42);
+        let cache = format!(
+            "/tmp/exact_{}_{}_{}_{n}.bin",
+            std::path::Path::new(path).file_stem().unwrap().to_string_lossy(),
+            mesh.0.len(),
+            mesh.1.len()
+        );
+        let exact: Vec<f64> = if let Ok(b) = std::fs::read(&cache) {
+            b.chunks(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
+        } else {
+            let e = MeshOracle::new(&mesh.0, &mesh.1, &Config::default())
+                .unwrap()
+                .winding_numbers(&queries, WindingMode::Exact)
+                .unwrap();
+            std::fs::write(&cache, e.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
+            e
+        };
+        let cfg = Config { exact_fallback_margin: 0.0, ..Config::default() };
+        let o = MeshOracle::new(&mesh.0, &mesh.1, &cfg).unwrap();
+        let t = std::time::Instant::now();
+        let w = o.winding_numbers(&queries, WindingMode::Fast).unwrap();
+        let s = t.elapsed().as_secs_f64();
+        let mut ws = occupancy::Workspace::new();
+        let mut tot = [0u64; 3];
+        for q in queries.iter().step_by(20) {
+            let c = o.winding_work(*q, WindingMode::Fast, &mut ws);
+            for k in 0..3 {
+                tot[k] += c[k];
+            }
+        }
+        let m = queries.iter().step_by(20).count() as f64;
+        let errs: Vec<f64> = w.iter().zip(&exact).map(|(a, b)| (a - b).abs()).collect();
+        let max = errs.iter().cloned().fold(0.0, f64::max);
+        let over = errs.iter().filter(|e| **e > 1e-3).count();
+        let flips = w.iter().zip(&exact).filter(|(a, b)| (a.abs() >= 0.5) != (b.abs() >= 0.5)).count();
+        let g = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+        let fb = g.query(&queries, WindingMode::Fast).unwrap().num_exact_fallbacks;
+        println!("{:>14} F={:>6} maxerr {:.2e} >1e-3: {:>4} flips {:>3} | fallback {:.3}% | visited {:>6.1} exp {:>6.1} tris {:>6.1} | {:.2} us/q",
+            std::path::Path::new(path).file_stem().unwrap().to_string_lossy(), mesh.1.len(), max, over, flips, fb as f64 / n as f64 * 100.0, tot[0] as f64 / m, tot[1] as f64 / m, tot[2] as f64 / m, s / n as f64 * 1e6);
+    }
+}
