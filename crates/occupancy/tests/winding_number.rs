@@ -44,6 +44,28 @@ fn packet_traversal_equals_one_query_at_a_time_bit_for_bit() {
     }
 }
 
+/// `winding_numbers_counted` reports how many fast values fell in the exact fallback band
+/// (what `voronoi-fit query --timings` and the benchmark print as the fallback share).
+#[test]
+fn fallback_count_is_the_number_of_fast_values_in_the_band() {
+    let mut total = 0;
+    for (name, mesh) in common::meshes_by_class() {
+        let oracle = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+        let queries = common::issue_queries(&mesh, 2000, 5);
+        let (_, count) = oracle.winding_numbers_counted(&queries, WindingMode::Fast).unwrap();
+        let mut ws = Workspace::new();
+        let expected = queries
+            .iter()
+            .filter(|q| oracle.config().needs_exact_fallback(oracle.winding_number_fast_unguarded(**q, &mut ws)))
+            .count();
+        assert_eq!(count as usize, expected, "{name}");
+        assert_eq!(oracle.winding_numbers_counted(&queries, WindingMode::Exact).unwrap().1, 0, "{name}");
+        total += count;
+    }
+    // The open and soup classes put queries in the band, so the count is exercised.
+    assert!(total > 0);
+}
+
 #[test]
 fn exact_hierarchical_sum_equals_brute_force_on_every_class() {
     for (name, mesh) in common::meshes_by_class() {
