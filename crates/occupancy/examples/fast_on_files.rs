@@ -37,22 +37,15 @@ fn main() {
         let t = std::time::Instant::now();
         let w = o.winding_numbers(&queries, WindingMode::Fast).unwrap();
         let s = t.elapsed().as_secs_f64();
-        let mut ws = occupancy::Workspace::new();
-        let mut tot = [0u64; 3];
-        for q in queries.iter().step_by(20) {
-            let c = o.winding_work(*q, WindingMode::Fast, &mut ws);
-            for k in 0..3 {
-                tot[k] += c[k];
-            }
-        }
-        let m = queries.iter().step_by(20).count() as f64;
+        let sampled: Vec<[f64; 3]> = queries.iter().step_by(20).copied().collect();
+        let work = common::fast_work_per_query(&o, &sampled);
         let errs: Vec<f64> = w.iter().zip(&exact).map(|(a, b)| (a - b).abs()).collect();
         let max = errs.iter().cloned().fold(0.0, f64::max);
         let over = errs.iter().filter(|e| **e > 1e-3).count();
         let flips = w.iter().zip(&exact).filter(|(a, b)| (a.abs() >= 0.5) != (b.abs() >= 0.5)).count();
         let g = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
-        let fb = g.query(&queries, WindingMode::Fast).unwrap().num_exact_fallbacks;
+        let (_, fb) = g.winding_numbers_counted(&queries, WindingMode::Fast).unwrap();
         println!("{:>14} F={:>6} maxerr {:.2e} >1e-3: {:>4} flips {:>3} | fallback {:.3}% | visited {:>6.1} exp {:>6.1} tris {:>6.1} | {:.2} us/q",
-            std::path::Path::new(path).file_stem().unwrap().to_string_lossy(), mesh.1.len(), max, over, flips, fb as f64 / n as f64 * 100.0, tot[0] as f64 / m, tot[1] as f64 / m, tot[2] as f64 / m, s / n as f64 * 1e6);
+            std::path::Path::new(path).file_stem().unwrap().to_string_lossy(), mesh.1.len(), max, over, flips, fb as f64 / n as f64 * 100.0, work[0], work[1], work[2], s / n as f64 * 1e6);
     }
 }

@@ -42,20 +42,8 @@ fn main() {
     };
     let s = t.elapsed().as_secs_f64();
     if kind == "fast" {
-        let mut ws = occupancy::Workspace::new();
-        let mut tot = [0u64; 3];
-        for q in queries.iter().take(20000) {
-            let c = oracle.winding_work(*q, WindingMode::Fast, &mut ws);
-            for k in 0..3 {
-                tot[k] += c[k];
-            }
-        }
-        println!(
-            "per query: visited {:.1}, expansions {:.1}, exact tris {:.1}",
-            tot[0] as f64 / 2e4,
-            tot[1] as f64 / 2e4,
-            tot[2] as f64 / 2e4
-        );
+        let [visited, expansions, exact] = common::fast_work_per_query(&oracle, &queries[..n.min(20_000)]);
+        println!("per query: visited {visited:.1}, expansions {expansions:.1}, exact tris {exact:.1}");
     }
     println!("{kind} {mesh_name} n={n}: {s:.3} s, {:.3} us/query (checksum {checksum:.6})", s / n as f64 * 1e6);
 }

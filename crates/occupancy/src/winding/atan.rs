@@ -40,33 +40,12 @@ const MOREBITS: f64 = 6.123_233_995_736_765_886_130E-17;
 fn atan_ratio(ay: f64, ax: f64) -> f64 {
     let big = ay > T3P8 * ax;
     let small = ay <= 0.66 * ax;
-    let num = if big {
-        -ax
+    let (num, den, base, more) = if big {
+        (-ax, ay, FRAC_PI_2, MOREBITS)
     } else if small {
-        ay
+        (ay, ax, 0.0, 0.0)
     } else {
-        ay - ax
-    };
-    let den = if big {
-        ay
-    } else if small {
-        ax
-    } else {
-        ay + ax
-    };
-    let base = if big {
-        FRAC_PI_2
-    } else if small {
-        0.0
-    } else {
-        FRAC_PI_4
-    };
-    let more = if big {
-        MOREBITS
-    } else if small {
-        0.0
-    } else {
-        0.5 * MOREBITS
+        (ay - ax, ay + ax, FRAC_PI_4, 0.5 * MOREBITS)
     };
     atan_reduced(num / den, base, more)
 }
@@ -85,9 +64,21 @@ fn atan_reduced(x: f64, base: f64, more: f64) -> f64 {
 /// arguments (and exactly on the axes, including signed zeros of `y`).
 #[inline(always)]
 pub fn atan2(y: f64, x: f64) -> f64 {
-    if !(x.is_finite() && y.is_finite()) || x == 0.0 {
+    if needs_libm(y, x) {
         return y.atan2(x);
     }
+    atan2_regular(y, x)
+}
+
+/// Arguments outside [`atan2_regular`]'s domain: a zero or non-finite `x`, a non-finite `y`.
+#[inline(always)]
+fn needs_libm(y: f64, x: f64) -> bool {
+    !(x.is_finite() && y.is_finite()) || x == 0.0
+}
+
+/// `atan2(y, x)` for finite `y` and finite non-zero `x`.
+#[inline(always)]
+fn atan2_regular(y: f64, x: f64) -> f64 {
     let a = atan_ratio(y.abs(), x.abs());
     let a = if x < 0.0 { PI - a } else { a };
     if y.is_sign_negative() {
@@ -98,22 +89,19 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 }
 
 /// [`atan2`] of `N` pairs at once, bit-identical to calling it on each pair (both run
-/// [`atan_ratio`], whose ranges are selected, not branched, so the loop vectorises). Lanes outside the fast path (a zero or non-finite `x`, a non-finite `y`)
-/// are recomputed one by one with [`atan2`].
+/// [`atan2_regular`], whose ranges are selected, not branched, so the loop vectorises).
+/// Lanes outside its domain ([`needs_libm`]) are recomputed one by one with [`atan2`].
 #[inline(always)]
 pub fn atan2_lanes<const N: usize>(y: &[f64; N], x: &[f64; N]) -> [f64; N] {
     let mut out = [0.0; N];
     let mut special = false;
     for i in 0..N {
-        let (yi, xi) = (y[i], x[i]);
-        special |= !(xi.is_finite() && yi.is_finite()) || xi == 0.0;
-        let a = atan_ratio(yi.abs(), xi.abs());
-        let a = if xi < 0.0 { PI - a } else { a };
-        out[i] = if yi.is_sign_negative() { -a } else { a };
+        special |= needs_libm(y[i], x[i]);
+        out[i] = atan2_regular(y[i], x[i]);
     }
     if special {
         for i in 0..N {
-            if !(x[i].is_finite() && y[i].is_finite()) || x[i] == 0.0 {
+            if needs_libm(y[i], x[i]) {
                 out[i] = atan2(y[i], x[i]);
             }
         }

@@ -16,6 +16,14 @@ use crate::vec3::{dot, norm, V3};
 ///   returns Ω/4π) operation by operation.
 #[inline(always)]
 pub fn solid_angle(q: V3, a: V3, b: V3, c: V3) -> f64 {
+    let (det, denom) = tangent_parts(q, a, b, c);
+    2.0 * super::atan::atan2(det, denom)
+}
+
+/// Numerator and denominator of `tan(Ω/2)` in [`solid_angle`] (shared with
+/// [`solid_angle_lanes`], so the two agree bit for bit).
+#[inline(always)]
+fn tangent_parts(q: V3, a: V3, b: V3, c: V3) -> (f64, f64) {
     let va = [a[0] - q[0], a[1] - q[1], a[2] - q[2]];
     let vb = [b[0] - q[0], b[1] - q[1], b[2] - q[2]];
     let vc = [c[0] - q[0], c[1] - q[1], c[2] - q[2]];
@@ -28,7 +36,7 @@ pub fn solid_angle(q: V3, a: V3, b: V3, c: V3) -> f64 {
         - vb[0] * va[1] * vc[2]
         - va[0] * vc[1] * vb[2];
     let denom = la * lb * lc + dot(vb, vc) * la + dot(vc, va) * lb + dot(va, vb) * lc;
-    2.0 * super::atan::atan2(det, denom)
+    (det, denom)
 }
 
 /// [`solid_angle`] of one triangle seen from `N` points `(qx[i], qy[i], qz[i])` at once,
@@ -39,18 +47,7 @@ pub fn solid_angle_lanes<const N: usize>(qx: &[f64; N], qy: &[f64; N], qz: &[f64
     let mut det = [0.0; N];
     let mut denom = [0.0; N];
     for i in 0..N {
-        let q = [qx[i], qy[i], qz[i]];
-        let va = [a[0] - q[0], a[1] - q[1], a[2] - q[2]];
-        let vb = [b[0] - q[0], b[1] - q[1], b[2] - q[2]];
-        let vc = [c[0] - q[0], c[1] - q[1], c[2] - q[2]];
-        let la = norm(va);
-        let lb = norm(vb);
-        let lc = norm(vc);
-        det[i] = va[0] * vb[1] * vc[2] + vb[0] * vc[1] * va[2] + vc[0] * va[1] * vb[2]
-            - vc[0] * vb[1] * va[2]
-            - vb[0] * va[1] * vc[2]
-            - va[0] * vc[1] * vb[2];
-        denom[i] = la * lb * lc + dot(vb, vc) * la + dot(vc, va) * lb + dot(va, vb) * lc;
+        (det[i], denom[i]) = tangent_parts([qx[i], qy[i], qz[i]], a, b, c);
     }
     let mut out = super::atan::atan2_lanes(&det, &denom);
     for o in &mut out {
@@ -62,6 +59,7 @@ pub fn solid_angle_lanes<const N: usize>(qx: &[f64; N], qy: &[f64; N], qz: &[f64
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     #[test]
     fn lanes_equal_one_at_a_time_bit_for_bit() {
@@ -77,9 +75,9 @@ mod tests {
                 *p = [next(), next(), next()];
             }
             if round % 5 == 0 {
-                q[round % 8] = tri[round % 3]; // a corner: zero length
-                q[(round + 3) % 8] = [0.3, 0.3, tri[0][2] + (0.3 - tri[0][0]) * 0.0];
-                // near the plane
+                // A corner (a zero length) and the centroid (on the triangle: det = 0).
+                q[round % 8] = tri[round % 3];
+                q[(round + 3) % 8] = std::array::from_fn(|k| (tri[0][k] + tri[1][k] + tri[2][k]) / 3.0);
             }
             let qx = q.map(|p| p[0]);
             let qy = q.map(|p| p[1]);
@@ -91,8 +89,6 @@ mod tests {
             }
         }
     }
-    use std::f64::consts::PI;
-
     #[test]
     fn octant_triangle_is_one_eighth_of_sphere() {
         // The triangle (e_x, e_y, e_z) seen from the origin covers one octant: 4π/8.

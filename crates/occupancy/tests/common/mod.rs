@@ -220,3 +220,17 @@ pub fn issue_queries(mesh: &Mesh, n: usize, seed: u64) -> Vec<[f64; 3]> {
     q.extend(occupancy::sample::near_surface(&sampler, n - n / 2, &[0.01 * diag], seed).unwrap());
     q
 }
+
+/// Mean work of one fast winding query over `queries` (`[nodes visited, expansions,
+/// triangles summed exactly]`, from [`occupancy::MeshOracle::winding_work`]).
+pub fn fast_work_per_query(oracle: &occupancy::MeshOracle, queries: &[[f64; 3]]) -> [f64; 3] {
+    let mut ws = occupancy::Workspace::new();
+    let mut total = [0u64; 3];
+    for q in queries {
+        let c = oracle.winding_work(*q, occupancy::WindingMode::Fast, &mut ws);
+        for k in 0..3 {
+            total[k] += c[k];
+        }
+    }
+    total.map(|t| t as f64 / queries.len().max(1) as f64)
+}
