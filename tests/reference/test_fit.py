@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 from scipy.spatial import cKDTree
+from scipy.stats import binomtest
 
 from conftest import ROOT, SHARED, assert_gltf_valid, run
 
@@ -37,6 +38,13 @@ def test_sites_file_reproduces_reported_misclassification(bin_path, tmp_path, me
     reported = report["quality"]["misclassification_uniform"]
     # Two independent estimates of the same rate on 100k and 100k samples.
     assert abs(ours - reported) < 3e-3 + 0.3 * reported, (ours, reported)
+
+    # The stated 95% intervals are scipy's Wilson score intervals of the stated counts.
+    q = report["quality"]
+    for wrong, n, ci in zip(q["misclassified_counts"], q["eval_counts"], q["misclassification_ci95"]):
+        ref = binomtest(wrong, n).proportion_ci(confidence_level=0.95, method="wilson")
+        assert ci == pytest.approx([ref.low, ref.high], abs=1e-12), (wrong, n, ci)
+    assert q["eval_counts"][0] == 200_000 and q["misclassified_counts"][0] == round(q["misclassification"] * 200_000)
 
     crust = trimesh.load(out, force="mesh")
     assert crust.is_watertight and crust.is_winding_consistent and crust.volume > 0

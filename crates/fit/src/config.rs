@@ -11,6 +11,11 @@ use crate::error::FitError;
 /// Default number of trainable sites.
 pub const DEFAULT_SITES: usize = 8192;
 
+/// Default number of fresh evaluation samples. At a typical 0.4% misclassification the
+/// 95% interval the report states is then ±0.025 points (±6% of the figure); 1M samples
+/// narrowed it to ±0.012 but cost 2–13 s of the main job (the Menger sponge's labelling).
+pub const DEFAULT_EVAL_SAMPLES: usize = 250_000;
+
 /// Empty space around the mesh in the unit cube (each side), as a fraction of the cube.
 pub const MARGIN: f64 = 0.05;
 
@@ -149,7 +154,7 @@ pub struct FitConfig {
 
 impl FitConfig {
     /// The default fit of `num_sites` sites ([`TrainConfig::default_for`]), seed 0,
-    /// 1,000,000 training and evaluation samples, no checkpoints.
+    /// 1,000,000 training samples, [`DEFAULT_EVAL_SAMPLES`] evaluation samples, no checkpoints.
     pub fn new(mesh: &str, num_sites: usize) -> Self {
         FitConfig {
             train: TrainConfig::default_for(num_sites),
@@ -163,7 +168,7 @@ impl FitConfig {
                 solid: SolidRule::Auto,
                 shell_thickness: None,
             },
-            eval: EvalSampling { samples: 1_000_000, sigmas: vec![0.01] },
+            eval: EvalSampling { samples: DEFAULT_EVAL_SAMPLES, sigmas: vec![0.01] },
             checkpointing: None,
             resume: None,
             output_precision: crust::output::Precision::F32,

@@ -33,7 +33,10 @@ pub mod report;
 mod run;
 pub mod target;
 
-pub use config::{Checkpointing, EvalSampling, FitConfig, Sampling, SolidRule, DEFAULT_CARVE, DEFAULT_SITES, MARGIN};
+pub use config::{
+    Checkpointing, EvalSampling, FitConfig, Sampling, SolidRule, DEFAULT_CARVE, DEFAULT_EVAL_SAMPLES, DEFAULT_SITES,
+    MARGIN,
+};
 pub use crust_step::{crust_of, CheckedCrust};
 pub use error::FitError;
 pub use grow::{fit_to_accuracy, AccuracyGoal};

@@ -45,7 +45,7 @@ pub struct FitOptions {
     pub w_surface: Option<f64>,
     /// Training sample pool (default 1,000,000).
     pub samples: Option<usize>,
-    /// Fresh samples for the misclassification figure (default 1,000,000).
+    /// Fresh samples for the misclassification figure (default [`crate::DEFAULT_EVAL_SAMPLES`]).
     pub eval_samples: Option<usize>,
     /// The solid to fit.
     pub solid: SolidRule,

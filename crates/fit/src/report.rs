@@ -130,6 +130,14 @@ pub struct QualityReport {
     pub misclassification_uniform: f64,
     /// The same among the near-surface points.
     pub misclassification_near_surface: f64,
+    /// Number of misclassified evaluation points (all, uniform, near-surface).
+    pub misclassified_counts: [usize; 3],
+    /// Number of evaluation points (all, uniform, near-surface).
+    pub eval_counts: [usize; 3],
+    /// 95% Wilson score intervals of the three shares above, in the same order: the
+    /// evaluation is a sample, and this is how far its figure can be from the share over
+    /// the whole sampling distribution.
+    pub misclassification_ci95: [[f64; 2]; 3],
     /// Seed of the evaluation pool.
     pub eval_seed: u64,
     /// Its near-surface spreads, fractions of the diagonal.
@@ -315,7 +323,7 @@ impl FitReport {
         };
         format!(
             "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
-             misclassified ({:.3}% of uniform, {:.3}% of near-surface ones).{}{} Crust: {} triangles, {} component(s), \
+             misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{} Crust: {} triangles, {} component(s), \
              genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{} {}{}",
             self.input.path,
             t.num_sites,
@@ -329,6 +337,8 @@ impl FitReport {
             },
             self.settings.eval_samples,
             100.0 * q.misclassification,
+            100.0 * q.misclassification_ci95[0][0],
+            100.0 * q.misclassification_ci95[0][1],
             100.0 * q.misclassification_uniform,
             100.0 * q.misclassification_near_surface,
             polished,
@@ -341,5 +351,42 @@ impl FitReport {
             metrics,
             target
         )
+    }
+}
+
+/// The 95% Wilson score interval of a proportion: `wrong` of `n` draws (z = 1.959964; no
+/// continuity correction, as scipy's `binomtest(...).proportion_ci(method="wilson")`).
+/// n = 0 gives [0, 1].
+pub fn wilson_interval(wrong: usize, n: usize) -> [f64; 2] {
+    if n == 0 {
+        return [0.0, 1.0];
+    }
+    const Z: f64 = 1.959_963_984_540_054;
+    let (k, n) = (wrong as f64, n as f64);
+    let p = k / n;
+    let z2 = Z * Z;
+    let denom = 1.0 + z2 / n;
+    let centre = (p + z2 / (2.0 * n)) / denom;
+    let half = Z / denom * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt();
+    [(centre - half).max(0.0), (centre + half).min(1.0)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wilson_interval;
+
+    #[test]
+    fn wilson_interval_known_values() {
+        // 0 of 10: [0, z²/(n + z²)]; 10 of 10 mirrors it; 0 of 0 says nothing.
+        let z2 = 1.959_963_984_540_054f64.powi(2);
+        let [lo, hi] = wilson_interval(0, 10);
+        assert_eq!(lo, 0.0);
+        assert!((hi - z2 / (10.0 + z2)).abs() < 1e-15);
+        let [lo2, hi2] = wilson_interval(10, 10);
+        assert!((lo2 - (1.0 - hi)).abs() < 1e-15 && (hi2 - 1.0).abs() < 1e-15);
+        assert_eq!(wilson_interval(0, 0), [0.0, 1.0]);
+        // 4,000 of 1,000,000 (0.4%): about ±0.0124 points, around 0.4%.
+        let [a, b] = wilson_interval(4_000, 1_000_000);
+        assert!(a < 0.004 && b > 0.004 && (b - a - 2.0 * 1.2374e-4).abs() < 2e-6, "{a} {b}");
     }
 }

@@ -10,6 +10,7 @@ use crate::config::{Config, MAX_COORDINATE};
 use crate::distance::{closest_point_slot, ClosestPoint};
 use crate::order::morton_order;
 use crate::vec3::V3;
+use crate::winding::crossing::{crossing_winding, degenerate_slots, Crossing};
 use crate::winding::exact::{build_caps, exact_solid_angle_sum, exact_traversal_counts, Caps};
 use crate::winding::fast::{
     build_fast_nodes, fast_solid_angle_sum, fast_solid_angle_sums, fast_traversal_counts, FastNodes,
@@ -49,6 +50,9 @@ pub struct MeshOracle {
     bvh: TriangleBvh,
     fast: FastNodes,
     caps: Caps,
+    /// Per slot, whether the triangle has zero area; empty unless the mesh is closed (then
+    /// [`MeshOracle::inside`] counts crossings).
+    degenerate: Vec<bool>,
     padding_squared: f64,
     num_vertices: usize,
 }
@@ -132,7 +136,8 @@ impl MeshOracle {
         let (lo, hi) = (bvh.box_lo[0], bvh.box_hi[0]);
         let diag2: f64 = (0..3).map(|k| (hi[k] - lo[k]) * (hi[k] - lo[k])).sum();
         let padding_squared = config.cap_box_padding * config.cap_box_padding * diag2;
-        Ok(MeshOracle { config: config.clone(), bvh, fast, caps, padding_squared, num_vertices })
+        let degenerate = if caps.is_closed() { degenerate_slots(&bvh) } else { Vec::new() };
+        Ok(MeshOracle { config: config.clone(), bvh, fast, caps, degenerate, padding_squared, num_vertices })
     }
 
     /// Builds the oracle for a [`mesh_io::TriMesh`] (see [`MeshOracle::new`] for the
@@ -267,6 +272,48 @@ impl MeshOracle {
     /// # Errors
     /// A query that is not finite.
     pub fn inside(&self, queries: &[V3]) -> Result<Vec<bool>, OccupancyError> {
+        validate_queries(queries)?;
+        if self.is_closed() {
+            return Ok(self.inside_by_crossings(queries));
+        }
+        Ok(self.map_coherent_winding(queries, WindingMode::Fast, |_, w, _| self.config.is_inside_winding(w)).0)
+    }
+
+    /// Whether the mesh is closed (its oriented edges cancel on welded vertices): then
+    /// [`MeshOracle::inside`] counts the crossings of a segment to the outside
+    /// ([`crate::winding::crossing`]) instead of summing solid angles.
+    pub fn is_closed(&self) -> bool {
+        self.caps.is_closed()
+    }
+
+    /// [`MeshOracle::inside`] on a closed mesh: exact integer winding numbers by crossing
+    /// counts; a query on a triangle, or one whose every direction is degenerate, takes the
+    /// exact solid-angle sum instead. The labels equal the solid-angle path's.
+    pub fn inside_by_crossings(&self, queries: &[V3]) -> Vec<bool> {
+        queries
+            .par_chunks(QUERY_CHUNK)
+            .flat_map_iter(|chunk| {
+                let mut stack = Vec::new();
+                let mut ws = Workspace::new();
+                chunk
+                    .iter()
+                    .map(|&q| match crossing_winding(&self.bvh, &self.degenerate, q, &mut stack) {
+                        Crossing::Winding(w) => self.config.is_inside_winding(w as f64),
+                        Crossing::OnSurface | Crossing::Degenerate => {
+                            self.config.is_inside_winding(self.winding_number_exact(q, &mut ws))
+                        }
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
+    /// [`MeshOracle::inside`] by the solid-angle sums (fast mode with the exact fallback),
+    /// whether or not the mesh is closed: the reference the crossing count is tested against.
+    ///
+    /// # Errors
+    /// A query that is not finite.
+    pub fn inside_by_winding(&self, queries: &[V3]) -> Result<Vec<bool>, OccupancyError> {
         validate_queries(queries)?;
         Ok(self.map_coherent_winding(queries, WindingMode::Fast, |_, w, _| self.config.is_inside_winding(w)).0)
     }

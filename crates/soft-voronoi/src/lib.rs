@@ -19,6 +19,7 @@ pub mod dense;
 pub mod error;
 pub mod init;
 pub mod kernel;
+pub mod knn;
 pub mod losses;
 pub mod polish;
 pub mod solid;

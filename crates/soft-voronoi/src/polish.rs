@@ -20,16 +20,13 @@
 //! the quality benchmark it raises normal consistency and lowers Chamfer on every mesh
 //! (README, "Surface quality").
 //!
-//! The neighbours are found with kiddo and held fixed for the gradient, as in the paper;
+//! The neighbours are found with [`crate::knn::KnnTree`] (exact) and held fixed for the gradient, as in the paper;
 //! the gradient is analytic (checked against finite differences in the tests). The run is
 //! reproducible bit for bit on any thread count: batches come from their own random stream
 //! per step, ties between equally near sites are broken by index, and the per-chunk
 //! gradients are summed in chunk order.
 
-use std::num::NonZero;
-
-use kiddo::immutable::float::kdtree::ImmutableKdTree;
-use kiddo::SquaredEuclidean;
+use crate::knn::KnnTree;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use vf_common::rng::{ChunkRng, Stream};
@@ -128,26 +125,19 @@ pub fn voroloss(sites: &[[f64; 3]], points: &[[f64; 3]], neighbours: usize, grad
     if sites.len() < 2 || points.is_empty() {
         return 0.0;
     }
-    let tree: ImmutableKdTree<f64, u32, 3, 32> = ImmutableKdTree::new_from_slice(sites);
-    let want = NonZero::new((neighbours + 1).min(sites.len())).expect("at least two sites");
+    let tree = KnnTree::new(sites);
+    let want = (neighbours + 1).min(sites.len());
     let trainable = grad.len();
     let n = points.len() as f64;
     let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
         .par_chunks(CHUNK)
         .map(|xs| {
             let mut out = Vec::with_capacity(2 * xs.len());
-            let mut near: Vec<(f64, u32)> = Vec::with_capacity(want.get());
+            let mut near: Vec<(f64, u32)> = Vec::with_capacity(want + 1);
             let mut loss = 0.0;
             for &x in xs {
-                near.clear();
-                for nb in tree.nearest_n::<SquaredEuclidean>(&x, want) {
-                    let p = sites[nb.item as usize];
-                    let d2 = (0..3).map(|c| (x[c] - p[c]) * (x[c] - p[c])).sum::<f64>();
-                    near.push((d2, nb.item));
-                }
-                // Exact f64 distances, ties by index: the result does not depend on the
-                // tree's internal order.
-                near.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                // Exact f64 distances, ties by index: the result does not depend on the tree.
+                tree.k_nearest(x, want, &mut near);
                 let i = near[0].1 as usize;
                 let pi = sites[i];
                 let mut best: Option<(f64, usize, [f64; 3], [f64; 3], f64)> = None;

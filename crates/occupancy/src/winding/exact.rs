@@ -117,6 +117,14 @@ fn welded_ids(corners: &[[V3; 3]]) -> (Vec<[u32; 3]>, Vec<V3>) {
 /// # Complexity
 /// O(F log F) time; the stored caps total at most O(F · depth) edges and in practice
 /// O(F) for manifold meshes.
+impl Caps {
+    /// Whether the whole mesh is closed: the root's boundary chain is empty (every
+    /// oriented edge cancels against a reversed one, on welded vertices).
+    pub fn is_closed(&self) -> bool {
+        self.start.first().is_some_and(|&s| s != u32::MAX) && self.len.first() == Some(&0)
+    }
+}
+
 pub fn build_caps(bvh: &TriangleBvh) -> Caps {
     let num_nodes = bvh.num_nodes();
     let (ids, points) = welded_ids(&bvh.corners);

@@ -2,6 +2,7 @@
 //! (Barill et al. 2018 order-2 expansion).
 
 pub mod atan;
+pub mod crossing;
 pub mod exact;
 pub mod fast;
 pub mod solid_angle;
