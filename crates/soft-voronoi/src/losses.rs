@@ -286,9 +286,10 @@ impl LabelledIndex {
         let inside_points: Vec<[f64; 3]> = inside.iter().map(|&i| sites[i as usize]).collect();
         let outside_points: Vec<[f64; 3]> = outside.iter().map(|&i| sites[i as usize]).collect();
         let tree = |p: &[[f64; 3]]| (!p.is_empty()).then(|| SiteIndex::new(p));
+        let (inside_tree, outside_tree) = rayon::join(|| tree(&inside_points), || tree(&outside_points));
         LabelledIndex {
-            inside_tree: tree(&inside_points),
-            outside_tree: tree(&outside_points),
+            inside_tree,
+            outside_tree,
             inside,
             outside,
             inside_points,

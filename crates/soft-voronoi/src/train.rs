@@ -470,7 +470,10 @@ fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, grad: &mut [[f6
     let (sites, labels) = (&state.sites, &state.labels);
     let k = state.config.num_sites;
     let w = &state.config.weights;
-    let index = SiteIndex::new(sites);
+    let wants_surface = w.surface > 0.0 && !batch.surface.is_empty();
+    // The three trees are built side by side (each build is serial).
+    let (index, labelled) =
+        rayon::join(|| SiteIndex::new(sites), || wants_surface.then(|| losses::LabelledIndex::new(sites, labels)));
     let rec =
         losses::reconstruction(kernel, &index, sites, labels, batch.points, batch.occupancy, w.reconstruction, grad);
     let bnd = losses::bounds(&sites[..k], w.bounds, grad);
@@ -484,11 +487,9 @@ fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, grad: &mut [[f6
     } else {
         0.0
     };
-    let srf = if w.surface > 0.0 && !batch.surface.is_empty() {
-        let labelled = losses::LabelledIndex::new(sites, labels);
-        losses::surface(&labelled, sites, batch.surface, batch.normals, w.normal, w.surface, grad)
-    } else {
-        0.0
+    let srf = match &labelled {
+        Some(labelled) => losses::surface(labelled, sites, batch.surface, batch.normals, w.normal, w.surface, grad),
+        None => 0.0,
     };
     Terms {
         total: w.reconstruction * rec + w.bounds * bnd + w.signed_distance * sdf + w.centroidal * cen + w.surface * srf,
