@@ -287,14 +287,7 @@ impl LabelledIndex {
         let outside_points: Vec<[f64; 3]> = outside.iter().map(|&i| sites[i as usize]).collect();
         let tree = |p: &[[f64; 3]]| (!p.is_empty()).then(|| SiteIndex::new(p));
         let (inside_tree, outside_tree) = rayon::join(|| tree(&inside_points), || tree(&outside_points));
-        LabelledIndex {
-            inside_tree,
-            outside_tree,
-            inside,
-            outside,
-            inside_points,
-            outside_points,
-        }
+        LabelledIndex { inside_tree, outside_tree, inside, outside, inside_points, outside_points }
     }
 
     /// The nearest inside and the nearest outside site of `x` (global indices), if both
