@@ -4,10 +4,10 @@
 //! Written here rather than taken from kiddo because of how kiddo's k-nearest query spends
 //! its time at this size: it offers every point of every visited leaf to a `SortedVec`
 //! (a heap allocation per query, an insertion with a shifted tail per point), and at
-//! K = 8,192 sites one 11-nearest query took about 2.5 µs, about ten times its nearest-one
+//! K = 8,192 sites one 11-nearest query took about 2.3 µs, about ten times its nearest-one
 //! query; the polish spent most of its time there. This tree keeps the k best in a
-//! caller-owned buffer and offers a point only when it beats the current k-th, so a query
-//! allocates nothing. kiddo stays for the one-nearest and radius queries of the kernel,
+//! caller-owned buffer (no allocation per query) and is about 1.2× faster (1.9 µs); the
+//! main job's polish went from 12.6 s to 10.1 s. kiddo stays for the one-nearest and radius queries of the kernel,
 //! where it is fast.
 //!
 //! The answer is exact and does not depend on the tree: squared distances are computed in
