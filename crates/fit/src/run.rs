@@ -331,12 +331,14 @@ fn misclassification(
     let wrong = |r: std::ops::Range<usize>| r.filter(|&i| predicted[i] != eval.occupancy[i]).count();
     let n = eval.points.len();
     let (wrong_u, wrong_n) = (wrong(0..num_uniform), wrong(num_uniform..n));
+    // All, uniform, near-surface.
     let counts = [n, num_uniform, n - num_uniform];
     let wrongs = [wrong_u + wrong_n, wrong_u, wrong_n];
+    let share = |i: usize| wrongs[i] as f64 / counts[i].max(1) as f64;
     Ok(QualityReport {
-        misclassification: (wrong_u + wrong_n) as f64 / n as f64,
-        misclassification_uniform: wrong_u as f64 / num_uniform.max(1) as f64,
-        misclassification_near_surface: wrong_n as f64 / (n - num_uniform).max(1) as f64,
+        misclassification: share(0),
+        misclassification_uniform: share(1),
+        misclassification_near_surface: share(2),
         misclassified_counts: wrongs,
         eval_counts: counts,
         misclassification_ci95: [0, 1, 2].map(|i| crate::report::wilson_interval(wrongs[i], counts[i])),

@@ -62,7 +62,7 @@ pub struct TopologyReport {
 
 /// Exact collinearity of three points: all three coordinate-plane projections have zero
 /// signed area (Shewchuk's adaptive orient2d, exact for finite doubles).
-fn collinear(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
+pub fn collinear(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
     let o = |i: usize, j: usize| {
         robust::orient2d(
             robust::Coord { x: a[i], y: a[j] },

@@ -10,18 +10,10 @@ use occupancy::{Config, MeshOracle, WindingMode};
 #[path = "../tests/common/mod.rs"]
 mod common;
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let n: usize = args[1].parse().unwrap();
-    for path in &args[2..] {
-        let m = mesh_io::read_mesh(std::path::Path::new(path)).unwrap();
-        let mesh = (m.positions.clone(), m.triangles.clone());
+    let (n, meshes) = common::count_and_meshes_from_args();
+    for (name, mesh) in meshes {
         let queries = common::issue_queries(&mesh, n, 42);
-        let cache = format!(
-            "/tmp/exact_{}_{}_{}_{n}.bin",
-            std::path::Path::new(path).file_stem().unwrap().to_string_lossy(),
-            mesh.0.len(),
-            mesh.1.len()
-        );
+        let cache = format!("/tmp/exact_{name}_{}_{}_{n}.bin", mesh.0.len(), mesh.1.len());
         let exact: Vec<f64> = if let Ok(b) = std::fs::read(&cache) {
             b.chunks(8).map(|c| f64::from_le_bytes(c.try_into().unwrap())).collect()
         } else {
@@ -46,6 +38,6 @@ fn main() {
         let g = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
         let (_, fb) = g.winding_numbers_counted(&queries, WindingMode::Fast).unwrap();
         println!("{:>14} F={:>6} maxerr {:.2e} >1e-3: {:>4} flips {:>3} | fallback {:.3}% | visited {:>6.1} exp {:>6.1} tris {:>6.1} | {:.2} us/q",
-            std::path::Path::new(path).file_stem().unwrap().to_string_lossy(), mesh.1.len(), max, over, flips, fb as f64 / n as f64 * 100.0, work[0], work[1], work[2], s / n as f64 * 1e6);
+            name, mesh.1.len(), max, over, flips, fb as f64 / n as f64 * 100.0, work[0], work[1], work[2], s / n as f64 * 1e6);
     }
 }

@@ -272,11 +272,11 @@ impl MeshOracle {
     /// # Errors
     /// A query that is not finite.
     pub fn inside(&self, queries: &[V3]) -> Result<Vec<bool>, OccupancyError> {
-        validate_queries(queries)?;
         if self.is_closed() {
+            validate_queries(queries)?;
             return Ok(self.inside_by_crossings(queries));
         }
-        Ok(self.map_coherent_winding(queries, WindingMode::Fast, |_, w, _| self.config.is_inside_winding(w)).0)
+        self.inside_by_winding(queries)
     }
 
     /// Whether the mesh is closed (its oriented edges cancel on welded vertices): then

@@ -37,8 +37,8 @@ fn closedness_by_class() {
 fn crossing_labels_equal_solid_angle_labels() {
     let mut meshes = common::meshes_by_class();
     for name in ["alecjacobson__spot.obj", "mikedh__quadknot.obj"] {
-        if let Ok(m) = mesh_io::read_mesh(&common::shared_meshes_dir().join(name)) {
-            meshes.push((name.to_string(), (m.positions, m.triangles)));
+        if let Some(m) = common::shared_mesh(name) {
+            meshes.push((name.to_string(), m));
         }
     }
     for (name, mesh) in meshes {

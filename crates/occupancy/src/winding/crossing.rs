@@ -42,18 +42,7 @@ const TILTS: [[f64; 2]; 4] = [[0.3127, 0.1913], [-0.2231, 0.3391], [0.4142, -0.2
 
 /// Per slot: whether the triangle has zero area (collinear corners, exact test).
 pub fn degenerate_slots(bvh: &TriangleBvh) -> Vec<bool> {
-    bvh.corners.iter().map(|t| is_collinear(t[0], t[1], t[2])).collect()
-}
-
-fn is_collinear(a: V3, b: V3, c: V3) -> bool {
-    let o2 = |i: usize, j: usize| {
-        robust::orient2d(
-            robust::Coord { x: a[i], y: a[j] },
-            robust::Coord { x: b[i], y: b[j] },
-            robust::Coord { x: c[i], y: c[j] },
-        )
-    };
-    o2(0, 1) == 0.0 && o2(1, 2) == 0.0 && o2(0, 2) == 0.0
+    bvh.corners.iter().map(|t| mesh_io::topology::collinear(t[0], t[1], t[2])).collect()
 }
 
 #[inline]

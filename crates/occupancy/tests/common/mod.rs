@@ -30,8 +30,26 @@ pub fn shared_mesh(name: &str) -> Option<Mesh> {
     } else if lower.ends_with(".ply") {
         Some(read_ascii_ply(&bytes))
     } else {
-        panic!("test helper cannot read {name}")
+        let m = mesh_io::read_mesh(&path).unwrap_or_else(|e| panic!("test helper cannot read {name}: {e}"));
+        Some((m.positions, m.triangles))
     }
+}
+
+/// The examples' command line `N MESH...`: N and each mesh file (read with mesh-io) with
+/// its file stem.
+#[allow(dead_code)]
+pub fn count_and_meshes_from_args() -> (usize, Vec<(String, Mesh)>) {
+    let args: Vec<String> = std::env::args().collect();
+    let n: usize = args.get(1).and_then(|a| a.parse().ok()).expect("usage: N MESH...");
+    let meshes = args[2..]
+        .iter()
+        .map(|path| {
+            let p = std::path::Path::new(path);
+            let m = mesh_io::read_mesh(p).unwrap_or_else(|e| panic!("{path}: {e}"));
+            (p.file_stem().unwrap_or_default().to_string_lossy().to_string(), (m.positions, m.triangles))
+        })
+        .collect();
+    (n, meshes)
 }
 
 /// Binary or ASCII STL, vertices welded by exact position (as mesh readers usually do).
