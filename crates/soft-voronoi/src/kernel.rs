@@ -14,15 +14,24 @@
 //! is exactly 0, so the denominator is ≥ 1 and nothing overflows or divides by zero for
 //! any β. Sites farther than d_min + τ/β carry a weight below e^−τ relative to the nearest
 //! one; they are left out, which changes V by at most (K−1)·e^−τ (τ = 30: 9.4e−14 per
-//! site). A k-d tree over the sites (kiddo, rebuilt when the sites move) finds the nearest
-//! site and then the sites within that radius, so a query costs O(log K + m) for m
-//! candidates instead of the dense O(K).
+//! site). A k-d tree over the sites ([`KnnTree`]) finds, in one traversal, the sites within
+//! that radius of the nearest, so a query costs O(log K + m) for m candidates instead of
+//! the dense O(K). A training sample drawn again carries the site that was nearest last
+//! time (a hint): its distance bounds the search from the start, so the tree is searched
+//! much less. The candidates, and so V and its gradient, do not depend on the hint.
 //!
 //! At d_k = 0 the distance is not differentiable; its gradient is taken as 0 there (a
 //! subgradient).
 
+use std::sync::OnceLock;
+
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
+
+use crate::knn::KnnTree;
+
+/// No hint: the sample has not been seen, or its last nearest site is unknown.
+pub const NO_HINT: u32 = u32::MAX;
 
 /// Default truncation τ: sites with weight below e^−τ of the nearest are ignored.
 pub const DEFAULT_TAU: f64 = 30.0;
@@ -48,57 +57,74 @@ impl Kernel {
     }
 }
 
-/// A k-d tree over site positions (kiddo `ImmutableKdTree`, bucket size 32), in `D`
-/// dimensions: 3 for meshes, 2 for the MNIST autoencoder. Everything in this module is
-/// generic over `D`, so the planar experiment runs the same kernel as the main job.
+/// The sites' k-d trees, in `D` dimensions: 3 for meshes, 2 for the MNIST autoencoder.
+/// Everything in this module is generic over `D`, so the planar experiment runs the same
+/// kernel as the main job.
+///
+/// The candidate query runs on this crate's [`KnnTree`]: it fuses the nearest query and
+/// the radius query into one traversal and writes into a caller-owned buffer; kiddo's
+/// radius query allocates a vector per call and needs a nearest query first, and the two
+/// were most of a training step. The plain nearest query (hard labels of many points)
+/// runs on kiddo's `ImmutableKdTree` (bucket size 32, SIMD leaf scans), built the first
+/// time it is asked for.
 pub struct SiteIndex<const D: usize = 3> {
-    tree: ImmutableKdTree<f64, u32, D, 32>,
-    num_sites: usize,
+    knn: KnnTree<D>,
+    kiddo: OnceLock<ImmutableKdTree<f64, u32, D, 32>>,
+    points: Vec<[f64; D]>,
 }
 
 impl<const D: usize> SiteIndex<D> {
-    /// Builds the tree over `sites` (finite coordinates; at least one site).
+    /// Builds the index over `sites` (finite coordinates; at least one site).
     pub fn new(sites: &[[f64; D]]) -> Self {
-        SiteIndex { tree: ImmutableKdTree::new_from_slice(sites), num_sites: sites.len() }
+        SiteIndex { knn: KnnTree::new(sites), kiddo: OnceLock::new(), points: sites.to_vec() }
     }
 
     /// Number of indexed sites.
     pub fn len(&self) -> usize {
-        self.num_sites
+        self.points.len()
     }
 
     /// Whether the index is empty.
     pub fn is_empty(&self) -> bool {
-        self.num_sites == 0
+        self.points.is_empty()
     }
 
     /// Index of a nearest site to `x` and its distance (recomputed exactly in f64 from
     /// `sites`).
     pub fn nearest(&self, sites: &[[f64; D]], x: [f64; D]) -> (u32, f64) {
-        let nn = self.tree.nearest_one::<SquaredEuclidean>(&x);
+        let tree = self.kiddo.get_or_init(|| ImmutableKdTree::new_from_slice(&self.points));
+        let nn = tree.nearest_one::<SquaredEuclidean>(&x);
         (nn.item, distance(x, sites[nn.item as usize]))
     }
 
     /// Fills `out` with (site, distance) for every site within `d_min + window` of `x`,
-    /// sorted by site index, and returns d_min. The distances are recomputed in f64 from
-    /// `sites` so the result does not depend on the tree's internal arithmetic.
+    /// sorted by site index, and returns d_min. Distances are computed in f64 by
+    /// [`distance`], so the result does not depend on the tree.
     pub fn candidates(&self, sites: &[[f64; D]], x: [f64; D], window: f64, out: &mut Vec<(u32, f64)>) -> f64 {
-        out.clear();
-        let (_, d_near) = self.nearest(sites, x);
-        let radius = d_near + window;
-        if radius < 1e150 {
-            // A hair larger than the radius so that rounding in the tree's squared
-            // distances never drops a site at the edge; the exact cut is applied below.
-            let r2 = radius * radius * (1.0 + 1e-12) + f64::MIN_POSITIVE;
-            for n in self.tree.within_unsorted::<SquaredEuclidean>(&x, r2) {
-                out.push((n.item, distance(x, sites[n.item as usize])));
-            }
-        } else {
-            out.extend(sites.iter().enumerate().map(|(k, &p)| (k as u32, distance(x, p))));
-        }
+        let mut hint = NO_HINT;
+        self.candidates_hinted(sites, x, window, &mut hint, out)
+    }
+
+    /// [`SiteIndex::candidates`] warm-started from `hint`, a site that was near `x`
+    /// before (or [`NO_HINT`]); `hint` is set to the nearest site (the lowest index among
+    /// equally near ones) for the next time. The candidates do not depend on the hint.
+    pub fn candidates_hinted(
+        &self,
+        sites: &[[f64; D]],
+        x: [f64; D],
+        window: f64,
+        hint: &mut u32,
+        out: &mut Vec<(u32, f64)>,
+    ) -> f64 {
+        let start = match sites.get(*hint as usize) {
+            Some(&p) => distance(x, p),
+            _ => f64::INFINITY,
+        };
+        let d_min = self.knn.window(x, window, start, out);
         out.sort_unstable_by_key(|c| c.0);
-        let d_min = out.iter().map(|c| c.1).fold(f64::INFINITY, f64::min).min(d_near);
-        out.retain(|c| c.1 <= d_min + window);
+        if let Some(c) = out.iter().find(|c| c.1 == d_min) {
+            *hint = c.0;
+        }
         d_min
     }
 }
@@ -167,9 +193,26 @@ pub fn value_and_grad<const D: usize>(
     labels: &[bool],
     x: [f64; D],
     s: &mut Scratch,
+    grad: impl FnMut(u32, [f64; D]),
+) -> f64 {
+    let mut hint = NO_HINT;
+    value_and_grad_hinted(kernel, index, sites, labels, x, &mut hint, s, grad)
+}
+
+/// [`value_and_grad`] warm-started from a hint (see [`SiteIndex::candidates_hinted`]);
+/// the result does not depend on it.
+#[allow(clippy::too_many_arguments)]
+pub fn value_and_grad_hinted<const D: usize>(
+    kernel: &Kernel,
+    index: &SiteIndex<D>,
+    sites: &[[f64; D]],
+    labels: &[bool],
+    x: [f64; D],
+    hint: &mut u32,
+    s: &mut Scratch,
     mut grad: impl FnMut(u32, [f64; D]),
 ) -> f64 {
-    let d_min = index.candidates(sites, x, kernel.window(), &mut s.candidates);
+    let d_min = index.candidates_hinted(sites, x, kernel.window(), hint, &mut s.candidates);
     let (v, z) = value_from_candidates(kernel, labels, &s.candidates, d_min, &mut s.weights);
     if s.candidates.len() < 2 {
         return v;

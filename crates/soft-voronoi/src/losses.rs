@@ -5,7 +5,8 @@
 
 use rayon::prelude::*;
 
-use crate::kernel::{self, Kernel, Scratch, SiteIndex};
+use crate::kernel::{self, Kernel, Scratch, SiteIndex, NO_HINT};
+use crate::knn::{self, KnnTree};
 
 /// Samples per parallel chunk (fixed: the reduction order depends on it).
 pub const CHUNK: usize = 1024;
@@ -16,6 +17,7 @@ pub const CHUNK: usize = 1024;
 ///
 /// - `sites`, `labels`: all K + B sites; `index` built over `sites`.
 /// - `points`, `occupancy`: the batch (unit-cube frame) and its ground truth.
+#[allow(clippy::too_many_arguments)]
 pub fn reconstruction<const D: usize>(
     kernel: &Kernel,
     index: &SiteIndex<D>,
@@ -26,18 +28,38 @@ pub fn reconstruction<const D: usize>(
     weight: f64,
     grad: &mut [[f64; D]],
 ) -> f64 {
+    let mut hints = vec![kernel::NO_HINT; points.len()];
+    reconstruction_hinted(kernel, index, sites, labels, points, occupancy, &mut hints, weight, grad)
+}
+
+/// [`reconstruction`] with one hint per point (a site near it, or
+/// [`kernel::NO_HINT`]), updated to each point's nearest site; the result does not depend
+/// on the hints (see [`SiteIndex::candidates_hinted`]).
+#[allow(clippy::too_many_arguments)]
+pub fn reconstruction_hinted<const D: usize>(
+    kernel: &Kernel,
+    index: &SiteIndex<D>,
+    sites: &[[f64; D]],
+    labels: &[bool],
+    points: &[[f64; D]],
+    occupancy: &[bool],
+    hints: &mut [u32],
+    weight: f64,
+    grad: &mut [[f64; D]],
+) -> f64 {
     let n = points.len().max(1) as f64;
     let trainable = grad.len() as u32;
     let parts: Vec<(f64, Vec<(u32, [f64; D])>)> = points
         .par_chunks(CHUNK)
         .zip(occupancy.par_chunks(CHUNK))
-        .map(|(xs, os)| {
+        .zip(hints.par_chunks_mut(CHUNK))
+        .map(|((xs, os), hs)| {
             let mut s = Scratch::default();
             let mut contributions = Vec::new();
             let mut loss = 0.0;
-            for (&x, &o) in xs.iter().zip(os) {
+            for ((&x, &o), h) in xs.iter().zip(os).zip(hs) {
                 let sign = if o { -1.0 } else { 1.0 };
-                let v = kernel::value_and_grad(kernel, index, sites, labels, x, &mut s, |k, g| {
+                let v = kernel::value_and_grad_hinted(kernel, index, sites, labels, x, h, &mut s, |k, g| {
                     if k < trainable {
                         contributions.push((k, g.map(|gc| sign * gc)));
                     }
@@ -266,10 +288,9 @@ pub struct LabelledIndex {
     pub inside: Vec<u32>,
     /// Global indices of the outside sites.
     pub outside: Vec<u32>,
-    inside_points: Vec<[f64; 3]>,
-    outside_points: Vec<[f64; 3]>,
-    inside_tree: Option<SiteIndex>,
-    outside_tree: Option<SiteIndex>,
+    labels: Vec<bool>,
+    inside_tree: KnnTree,
+    outside_tree: KnnTree,
 }
 
 impl LabelledIndex {
@@ -283,19 +304,36 @@ impl LabelledIndex {
                 outside.push(i as u32)
             }
         }
-        let inside_points: Vec<[f64; 3]> = inside.iter().map(|&i| sites[i as usize]).collect();
-        let outside_points: Vec<[f64; 3]> = outside.iter().map(|&i| sites[i as usize]).collect();
-        let tree = |p: &[[f64; 3]]| (!p.is_empty()).then(|| SiteIndex::new(p));
-        let (inside_tree, outside_tree) = rayon::join(|| tree(&inside_points), || tree(&outside_points));
-        LabelledIndex { inside_tree, outside_tree, inside, outside, inside_points, outside_points }
+        let tree = |ids: &[u32]| KnnTree::new(&ids.iter().map(|&i| sites[i as usize]).collect::<Vec<_>>());
+        let (inside_tree, outside_tree) = rayon::join(|| tree(&inside), || tree(&outside));
+        LabelledIndex { inside_tree, outside_tree, inside, outside, labels: labels.to_vec() }
     }
 
-    /// The nearest inside and the nearest outside site of `x` (global indices), if both
-    /// sides have sites.
-    pub fn nearest_pair(&self, x: [f64; 3]) -> Option<(u32, u32)> {
-        let a = self.inside_tree.as_ref()?.nearest(&self.inside_points, x).0;
-        let b = self.outside_tree.as_ref()?.nearest(&self.outside_points, x).0;
-        Some((self.inside[a as usize], self.outside[b as usize]))
+    /// The nearest inside and the nearest outside site of `x` (global indices; ties by
+    /// index), if both sides have sites.
+    pub fn nearest_pair(&self, sites: &[[f64; 3]], x: [f64; 3]) -> Option<(u32, u32)> {
+        self.nearest_pair_hinted(sites, x, &mut [NO_HINT; 2])
+    }
+
+    /// [`LabelledIndex::nearest_pair`] warm-started from `hints` (an inside and an outside
+    /// site that were near `x` before, global indices, or [`NO_HINT`]), which are set to
+    /// the answer; the answer does not depend on them. `sites` are the indexed ones.
+    pub fn nearest_pair_hinted(&self, sites: &[[f64; 3]], x: [f64; 3], hints: &mut [u32; 2]) -> Option<(u32, u32)> {
+        let side = |tree: &KnnTree, ids: &[u32], hint: &mut u32, label: bool| {
+            // Any site of this side bounds the nearest one's squared distance (computed as
+            // the tree computes it), so the search starts bounded.
+            let bound2 = match self.labels.get(*hint as usize) {
+                Some(&l) if l == label => knn::d2(x, sites[*hint as usize]),
+                _ => f64::INFINITY,
+            };
+            let (_, local) = tree.nearest_within(x, bound2)?;
+            *hint = ids[local as usize];
+            Some(*hint)
+        };
+        let [hi, ho] = hints;
+        let a = side(&self.inside_tree, &self.inside, hi, true)?;
+        let b = side(&self.outside_tree, &self.outside, ho, false)?;
+        Some((a, b))
     }
 }
 
@@ -320,16 +358,35 @@ pub fn surface(
     weight: f64,
     grad: &mut [[f64; 3]],
 ) -> f64 {
+    let mut hints = vec![[NO_HINT; 2]; points.len()];
+    surface_hinted(index, sites, points, normals, &mut hints, normal_weight, weight, grad)
+}
+
+/// [`surface`] warm-started: `hints` holds, per point, an inside and an outside site that
+/// were near it (or [`NO_HINT`]), and is set to the nearest pair; the result does not
+/// depend on it.
+#[allow(clippy::too_many_arguments)]
+pub fn surface_hinted(
+    index: &LabelledIndex,
+    sites: &[[f64; 3]],
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    hints: &mut [[u32; 2]],
+    normal_weight: f64,
+    weight: f64,
+    grad: &mut [[f64; 3]],
+) -> f64 {
     let m = points.len().max(1) as f64;
     let trainable = grad.len() as u32;
     let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
         .par_chunks(CHUNK)
         .zip(normals.par_chunks(CHUNK))
-        .map(|(xs, ns)| {
+        .zip(hints.par_chunks_mut(CHUNK))
+        .map(|((xs, ns), hs)| {
             let mut contributions = Vec::with_capacity(2 * xs.len());
             let mut loss = 0.0;
-            for (&x, &nx) in xs.iter().zip(ns) {
-                let Some((ia, ib)) = index.nearest_pair(x) else { continue };
+            for ((&x, &nx), h) in xs.iter().zip(ns).zip(hs) {
+                let Some((ia, ib)) = index.nearest_pair_hinted(sites, x, h) else { continue };
                 let (a, b) = (sites[ia as usize], sites[ib as usize]);
                 let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
                 let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();

@@ -132,6 +132,7 @@ struct SelectionBatch {
     occupancy: Vec<bool>,
     surface: Vec<[f64; 3]>,
     normals: Vec<[f64; 3]>,
+    hints: Hints,
 }
 
 impl SelectionBatch {
@@ -156,7 +157,25 @@ impl SelectionBatch {
                 normals.push(data.normals.get(i).copied().unwrap_or([0.0; 3]));
             }
         }
-        Some(SelectionBatch { points, occupancy, surface, normals })
+        let hints = Hints::new(points.len(), surface.len());
+        Some(SelectionBatch { points, occupancy, surface, normals, hints })
+    }
+}
+
+/// Warm starts of the nearest-site queries, one per training sample and per surface
+/// sample: the site(s) that were nearest the last time the sample was drawn
+/// ([`SiteIndex::candidates_hinted`], [`losses::LabelledIndex::nearest_pair_hinted`]).
+/// They only make the queries faster (a sample's nearest site rarely changes between
+/// draws) and never change a result, so they are not part of the saved state: a resumed
+/// run starts without them and continues bit-identically.
+struct Hints {
+    points: Vec<u32>,
+    surface: Vec<[u32; 2]>,
+}
+
+impl Hints {
+    fn new(points: usize, surface: usize) -> Self {
+        Hints { points: vec![kernel::NO_HINT; points], surface: vec![[kernel::NO_HINT; 2]; surface] }
     }
 }
 
@@ -171,6 +190,13 @@ pub struct Trainer<'a> {
     surface_points: Vec<[f64; 3]>,
     surface_normals: Vec<[f64; 3]>,
     selection: Option<SelectionBatch>,
+    /// Hints of the whole sample pool (`data.points`, `data.surface`).
+    pool_hints: Hints,
+    /// Indices into the pool of this step's batch and surface batch.
+    batch_ids: Vec<u32>,
+    surface_ids: Vec<u32>,
+    /// This step's hints, gathered from the pool and scattered back after the step.
+    batch_hints: Hints,
 }
 
 impl<'a> Trainer<'a> {
@@ -289,6 +315,10 @@ impl<'a> Trainer<'a> {
             surface_points: Vec::new(),
             surface_normals: Vec::new(),
             selection: SelectionBatch::draw(&state.config, data),
+            pool_hints: Hints::new(data.points.len(), data.surface.len()),
+            batch_ids: Vec::with_capacity(b),
+            surface_ids: Vec::new(),
+            batch_hints: Hints::new(0, 0),
             state,
         }
     }
@@ -296,24 +326,25 @@ impl<'a> Trainer<'a> {
     /// The total loss of the current sites on the fixed evaluation batch, at the final β
     /// (so iterates are compared on one scale whatever the annealing), without touching
     /// the optimiser. Centroidal and signed-distance terms use the state's last refresh.
-    fn selection_loss(&self, batch: &SelectionBatch) -> f64 {
+    fn selection_loss(&self, batch: &mut SelectionBatch) -> f64 {
         let cfg = &self.state.config;
         let kernel = Kernel { beta: cfg.beta, tau: cfg.tau };
         let mut grad = vec![[0.0; 3]; cfg.num_sites];
-        let batch = Batch {
+        let sel = Batch {
             points: &batch.points,
             occupancy: &batch.occupancy,
             surface: &batch.surface,
             normals: &batch.normals,
         };
-        objective(&self.state, &kernel, &batch, &mut grad).total
+        objective(&self.state, &kernel, &sel, &mut batch.hints, &mut grad).total
     }
 
     /// Measures the current sites on the evaluation batch and keeps them if they are the
     /// best so far (ties keep the earlier iterate).
     fn consider_current(&mut self) {
-        let Some(batch) = &self.selection else { return };
-        let loss = self.selection_loss(batch);
+        let Some(mut batch) = self.selection.take() else { return };
+        let loss = self.selection_loss(&mut batch);
+        self.selection = Some(batch);
         let st = &mut self.state;
         if loss.is_finite() && st.best.as_ref().is_none_or(|b| loss < b.loss) {
             let k = st.config.num_sites;
@@ -375,13 +406,19 @@ impl<'a> Trainer<'a> {
         let n = self.data.points.len() as u64;
         self.batch_points.clear();
         self.batch_occupancy.clear();
+        self.batch_ids.clear();
+        self.batch_hints.points.clear();
         for _ in 0..cfg.batch {
             let i = (rng.next_u64() % n) as usize;
             self.batch_points.push(self.data.points[i]);
             self.batch_occupancy.push(self.data.occupancy[i]);
+            self.batch_ids.push(i as u32);
+            self.batch_hints.points.push(self.pool_hints.points[i]);
         }
         self.surface_points.clear();
         self.surface_normals.clear();
+        self.surface_ids.clear();
+        self.batch_hints.surface.clear();
         if w.surface > 0.0 && !self.data.surface.is_empty() {
             let mut rng = ChunkRng::for_chunk(cfg.seed, Stream::SurfaceBatch, t as u64);
             let m = self.data.surface.len() as u64;
@@ -389,6 +426,8 @@ impl<'a> Trainer<'a> {
                 let i = (rng.next_u64() % m) as usize;
                 self.surface_points.push(self.data.surface[i]);
                 self.surface_normals.push(self.data.normals.get(i).copied().unwrap_or([0.0; 3]));
+                self.surface_ids.push(i as u32);
+                self.batch_hints.surface.push(self.pool_hints.surface[i]);
             }
         }
         self.grad.iter_mut().for_each(|g| *g = [0.0; 3]);
@@ -399,7 +438,13 @@ impl<'a> Trainer<'a> {
             normals: &self.surface_normals,
         };
         let Terms { total, reconstruction: rec, bounds: bnd, signed_distance: sdf, centroidal: cen, surface: srf } =
-            objective(st, &kernel, &batch, &mut self.grad);
+            objective(st, &kernel, &batch, &mut self.batch_hints, &mut self.grad);
+        for (&i, &h) in self.batch_ids.iter().zip(&self.batch_hints.points) {
+            self.pool_hints.points[i as usize] = h;
+        }
+        for (&i, &h) in self.surface_ids.iter().zip(&self.batch_hints.surface) {
+            self.pool_hints.surface[i as usize] = h;
+        }
         if !total.is_finite() || !self.grad.iter().flatten().all(|g| g.is_finite()) {
             return Err(TrainError::Diverged { step: t, what: format!("loss {total}") });
         }
@@ -466,7 +511,7 @@ struct Terms {
 /// `grad` (the trainable sites'): the one definition a training step and the best-iterate
 /// selection share. The signed-distance and centroidal terms use the state's last refresh
 /// (closest points, Delaunay graph).
-fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, grad: &mut [[f64; 3]]) -> Terms {
+fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, hints: &mut Hints, grad: &mut [[f64; 3]]) -> Terms {
     let (sites, labels) = (&state.sites, &state.labels);
     let k = state.config.num_sites;
     let w = &state.config.weights;
@@ -474,8 +519,17 @@ fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, grad: &mut [[f6
     // The three trees are built side by side (each build is serial).
     let (index, labelled) =
         rayon::join(|| SiteIndex::new(sites), || wants_surface.then(|| losses::LabelledIndex::new(sites, labels)));
-    let rec =
-        losses::reconstruction(kernel, &index, sites, labels, batch.points, batch.occupancy, w.reconstruction, grad);
+    let rec = losses::reconstruction_hinted(
+        kernel,
+        &index,
+        sites,
+        labels,
+        batch.points,
+        batch.occupancy,
+        &mut hints.points,
+        w.reconstruction,
+        grad,
+    );
     let bnd = losses::bounds(&sites[..k], w.bounds, grad);
     let sdf = if w.signed_distance > 0.0 && state.located.len() == k {
         losses::signed_distance_cached(&state.located, &sites[..k], &labels[..k], w.signed_distance, grad)
@@ -488,7 +542,16 @@ fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, grad: &mut [[f6
         0.0
     };
     let srf = match &labelled {
-        Some(labelled) => losses::surface(labelled, sites, batch.surface, batch.normals, w.normal, w.surface, grad),
+        Some(labelled) => losses::surface_hinted(
+            labelled,
+            sites,
+            batch.surface,
+            batch.normals,
+            &mut hints.surface,
+            w.normal,
+            w.surface,
+            grad,
+        ),
         None => 0.0,
     };
     Terms {
