@@ -129,15 +129,11 @@ impl<const D: usize> SiteIndex<D> {
     }
 }
 
-/// Euclidean distance in `D` dimensions.
+/// Euclidean distance in `D` dimensions: the square root of [`crate::knn::d2`], so the
+/// kernel's distances and the tree's agree bit for bit.
 #[inline]
 pub fn distance<const D: usize>(a: [f64; D], b: [f64; D]) -> f64 {
-    let mut s = 0.0;
-    for c in 0..D {
-        let d = a[c] - b[c];
-        s += d * d;
-    }
-    s.sqrt()
+    crate::knn::d2(a, b).sqrt()
 }
 
 /// Scratch space for one thread's queries.
