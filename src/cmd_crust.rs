@@ -77,6 +77,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             "output_precision": format!("{precision:?}").to_lowercase(),
             "num_merged_in_output": written.num_merged_vertices,
             "num_separated_in_output": written.num_separated_vertices,
+            "topology_before_rounding": written.topology_before,
             "num_cells": num_cells,
             "genus": check.report.genus,
             "num_components": check.report.num_components,
@@ -87,7 +88,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::output::out!("{}", serde_json::to_string_pretty(&j).map_err(anyhow::Error::from)?);
     } else {
         crate::output::out!(
-            "{}: {} sites ({} inside) -> crust of {} triangles, {} vertices, {} component(s), genus {}, volume {:.6e} (mesh units), closed and manifold, checked as written; {:.3} s.",
+            "{}: {} sites ({} inside) -> crust of {} triangles, {} vertices, {} component(s), genus {}, volume {:.6e} (mesh units), closed and manifold, checked as written; {:.3} s.{}",
             args.output.display(),
             s.num_sites,
             s.num_inside,
@@ -96,7 +97,8 @@ pub fn run(args: Args) -> Result<(), CliError> {
             check.report.num_components,
             check.report.genus.map_or("n/a".to_string(), |g| g.to_string()),
             volume,
-            s.total_seconds
+            s.total_seconds,
+            crust::output::topology_note(written.topology_before).map_or(String::new(), |n| format!(" {n}"))
         );
     }
     Ok(())

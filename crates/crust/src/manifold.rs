@@ -212,32 +212,28 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, Bui
     // may share two corners that are not neighbours) and, in the projection along its
     // dominant normal axis, without a triangle of the wrong orientation or zero area
     // (exact orient2d): rebuilt polygons can be non-convex, with corners bent by an ulp.
-    // A fan from the preferred corner if that works, else from another corner, else ear
-    // clipping, else a fan from a new vertex at the centroid.
+    // The best-shaped such triangulation (`triangulate`), else a fan from a new vertex at
+    // the centroid.
     let mut taken: HashSet<(u32, u32)> = HashSet::new();
-    let mut polys: Vec<(Vec<u32>, usize)> = Vec::with_capacity(polygons.len());
+    let mut polys: Vec<Vec<u32>> = Vec::with_capacity(polygons.len());
     for (f, p) in polygons.iter().enumerate() {
         let o = offset[f];
         let mut ids = Vec::with_capacity(p.len() + 1);
-        let mut apex = 0;
         for i in 0..p.len() {
             ids.push(corner_vertex[o + i]);
             if midpoint_after[o + i] != u32::MAX {
                 ids.push(midpoint_after[o + i]);
-                // Fan from an inserted midpoint: it lies inside an edge of the convex
-                // polygon, so no fan triangle is degenerate.
-                apex = ids.len() - 1;
             }
         }
         for i in 0..ids.len() {
             taken.insert(ukey(ids[i], ids[(i + 1) % ids.len()]));
         }
-        polys.push((ids, apex));
+        polys.push(ids);
     }
     let mut tris = Vec::new();
-    for (ids, preferred) in &polys {
+    for ids in &polys {
         tris.clear();
-        if triangulate(ids, *preferred, &mesh.positions, &taken, &mut tris) {
+        if triangulate(ids, &mesh.positions, &taken, &mut tris) {
             for &[a, b, c] in &tris {
                 for (x, y) in [(a, b), (b, c), (c, a)] {
                     taken.insert(ukey(x, y));
@@ -258,7 +254,21 @@ pub(crate) fn build(polygons: &[Vec<u32>], positions: &[V]) -> Result<Built, Bui
         mesh.triangles.extend_from_slice(&tris);
     }
     let num_used = used.iter().filter(|&&u| u).count();
-    let faces = polys.into_iter().map(|(ids, _)| ids).collect();
+    // Number the vertices in order of first use by the triangles, as readers of OBJ and
+    // PLY files number them, so that a written crust reads back as the same mesh.
+    let mut new_id = vec![u32::MAX; mesh.positions.len()];
+    let mut order: Vec<u32> = Vec::with_capacity(mesh.positions.len());
+    for v in mesh.triangles.iter().flatten().copied().chain(0..mesh.positions.len() as u32) {
+        if new_id[v as usize] == u32::MAX {
+            new_id[v as usize] = order.len() as u32;
+            order.push(v);
+        }
+    }
+    mesh.positions = order.iter().map(|&v| mesh.positions[v as usize]).collect();
+    let source = order.iter().map(|&v| source[v as usize]).collect();
+    let computed = order.iter().map(|&v| computed[v as usize]).collect();
+    mesh.triangles.iter_mut().flatten().for_each(|v| *v = new_id[*v as usize]);
+    let faces = polys.into_iter().map(|f| f.into_iter().map(|v| new_id[v as usize]).collect()).collect();
     Ok(Built { mesh, num_used, num_split: copies, source, computed, faces })
 }
 
@@ -268,15 +278,24 @@ fn ukey(a: u32, b: u32) -> (u32, u32) {
 
 /// Triangulate the polygon `ids` (mesh vertex ids, counter-clockwise seen from outside)
 /// into `out`: every triangle positively oriented in the projection along the polygon's
-/// dominant normal axis (exact orient2d), no new edge in `taken`. `false` when neither a
-/// fan (from `preferred` first) nor ear clipping finds one.
-fn triangulate(
-    ids: &[u32],
-    preferred: usize,
-    positions: &[V],
-    taken: &HashSet<(u32, u32)>,
-    out: &mut Vec<[u32; 3]>,
-) -> bool {
+/// dominant normal axis (exact orient2d), no new edge in `taken`, and among those
+/// triangulations the one whose worst triangle is best shaped (largest smallest
+/// [`shape`]). `false` when there is none.
+///
+/// Why the best-shaped one and not the first fan that is valid: a Voronoi face often has
+/// a corner that is all but straight (a short Voronoi edge of a nearly degenerate cluster,
+/// or an inserted midpoint). A fan from another corner makes that corner the middle of a
+/// sliver whose width is below the rounding of the output's floats, and once rounded the
+/// sliver folds onto its neighbours (the crust of the soup in `../shared/meshes`, written
+/// as float32, failed so). The best-shaped triangulation uses such a corner as an apex.
+///
+/// Dynamic programming over the sub-polygons `ids[i..=j]` (Klincsek's optimal polygon
+/// triangulation), O(n³) for n corners; Voronoi faces have a handful. Every triangle of a
+/// triangulation by diagonals being positively oriented in the projection makes it a
+/// triangulation of the (possibly non-convex) polygon: the triangles' signed coverage is
+/// the polygon's winding number, so positive triangles cover each inside point once and
+/// nothing outside.
+fn triangulate(ids: &[u32], positions: &[V], taken: &HashSet<(u32, u32)>, out: &mut Vec<[u32; 3]>) -> bool {
     let n = ids.len();
     if n == 3 {
         out.push([ids[0], ids[1], ids[2]]);
@@ -300,53 +319,62 @@ fn triangulate(
         robust::Coord { x, y: if flip { -y } else { y } }
     };
     let ccw = |a: u32, b: u32, c: u32| robust::orient2d(pt(a), pt(b), pt(c)) > 0.0;
-    let fan_ok = |apex: usize| {
-        (2..n - 1).all(|k| !taken.contains(&ukey(ids[apex], ids[(apex + k) % n])))
-            && (1..n - 1).all(|k| ccw(ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]))
-    };
-    if let Some(apex) = std::iter::once(preferred).chain((0..n).filter(|&a| a != preferred)).find(|&a| fan_ok(a)) {
-        for k in 1..n - 1 {
-            out.push([ids[apex], ids[(apex + k) % n], ids[(apex + k + 1) % n]]);
-        }
-        return true;
+    // A diagonal (not a polygon edge) may not be an edge elsewhere.
+    let open = |i: usize, j: usize| j == i + 1 || (i == 0 && j == n - 1) || !taken.contains(&ukey(ids[i], ids[j]));
+    // best[i][j]: the best worst shape over triangulations of ids[i..=j] (−1: none), and the
+    // apex k of its triangle on the diagonal (i, j).
+    let mut best = vec![-1.0f64; n * n];
+    let mut apex = vec![usize::MAX; n * n];
+    for i in 0..n - 1 {
+        best[i * n + i + 1] = f64::INFINITY;
     }
-    // Ear clipping: a corner whose triangle is counter-clockwise, contains no other corner
-    // (closed test) and whose new edge is not taken.
-    let mut ring: Vec<u32> = ids.to_vec();
-    let mut new_edges: HashSet<(u32, u32)> = HashSet::new();
-    while ring.len() > 3 {
-        let m = ring.len();
-        let ear = (0..m).find(|&i| {
-            let (a, b, c) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
-            if !ccw(a, b, c) || taken.contains(&ukey(a, c)) || new_edges.contains(&ukey(a, c)) {
-                return false;
+    for len in 2..n {
+        for i in 0..n - len {
+            let j = i + len;
+            if !open(i, j) {
+                continue;
             }
-            let (pa, pb, pc) = (pt(a), pt(b), pt(c));
-            ring.iter().all(|&v| {
-                if v == a || v == b || v == c {
-                    return true;
+            for k in i + 1..j {
+                let worst = best[i * n + k].min(best[k * n + j]);
+                if !(worst > best[i * n + j]) || !ccw(ids[i], ids[k], ids[j]) {
+                    continue;
                 }
-                let q = pt(v);
-                !(robust::orient2d(pa, pb, q) >= 0.0
-                    && robust::orient2d(pb, pc, q) >= 0.0
-                    && robust::orient2d(pc, pa, q) >= 0.0)
-            })
-        });
-        let Some(i) = ear else {
-            out.clear();
-            return false;
-        };
-        let (a, b, c) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
-        out.push([a, b, c]);
-        new_edges.insert(ukey(a, c));
-        ring.remove(i);
+                let q = worst.min(shape(positions, ids[i], ids[k], ids[j]));
+                if q > best[i * n + j] {
+                    best[i * n + j] = q;
+                    apex[i * n + j] = k;
+                }
+            }
+        }
     }
-    if !ccw(ring[0], ring[1], ring[2]) {
-        out.clear();
+    if apex[n - 1] == usize::MAX {
         return false;
     }
-    out.push([ring[0], ring[1], ring[2]]);
+    let mut stack = vec![(0, n - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let k = apex[i * n + j];
+        out.push([ids[i], ids[k], ids[j]]);
+        stack.push((i, k));
+        stack.push((k, j));
+    }
     true
+}
+
+/// Shape of a triangle: twice its area over its longest edge squared (2·height/base over
+/// the longest edge; at most √3/2·… for the equilateral, 0 for a degenerate one), in f64.
+/// Only ranks triangulations; validity is decided exactly.
+fn shape(positions: &[V], a: u32, b: u32, c: u32) -> f64 {
+    let [pa, pb, pc] = [a, b, c].map(|v| positions[v as usize]);
+    let area2 = dot(cross(sub(pb, pa), sub(pc, pa)), cross(sub(pb, pa), sub(pc, pa))).sqrt();
+    let longest = [sub(pb, pa), sub(pc, pb), sub(pa, pc)].iter().map(|e| dot(*e, *e)).fold(0.0f64, f64::max);
+    if longest > 0.0 {
+        area2 / longest
+    } else {
+        0.0
+    }
 }
 
 /// Pair the 2k half-edges around edge (u, v) by the angle of their faces about the edge.

@@ -187,6 +187,21 @@ pub struct Finalized {
     /// because they shared a position with another vertex (split vertices, or vertices
     /// that rounding made coincident and that could not be merged).
     pub num_separated_vertices: usize,
+    /// Components and genus of the crust before rounding, when rounding changed them:
+    /// a handle or a gap thinner than a few units in the last place of the output's
+    /// floats closed (vertices that close apart weld or had to be merged). `None` when
+    /// the written crust has the topology of the exact one.
+    pub topology_before: Option<(usize, i64)>,
+}
+
+/// A sentence for summaries when rounding to the output's floats changed the crust's
+/// topology ([`Finalized::topology_before`]; `None` when it did not).
+pub fn topology_note(topology_before: Option<(usize, i64)>) -> Option<String> {
+    let (c, g) = topology_before?;
+    Some(format!(
+        "Rounding to the file's floats merged vertices a few float spacings apart, which changed the topology where \
+         the crust is that thin (the exact crust has {c} component(s) of genus {g})."
+    ))
 }
 
 /// The crust exactly as a file in `precision` will hold it, checked.
@@ -205,7 +220,9 @@ pub struct Finalized {
 /// repair of [`Crust::extract`](crate::Crust::extract), in units of the output's
 /// precision), and copies of one position that must stay apart (split vertices) are
 /// moved apart by a few units in the last place into their own solid. The result is
-/// checked exactly; when rounding broke nothing it is the mapped mesh itself.
+/// checked exactly; when rounding broke nothing it is the mapped mesh itself. Merging may
+/// close a handle or a gap only when it is at most a few units in the last place thin
+/// (the floats cannot keep it open); [`Finalized::topology_before`] then says so.
 ///
 /// # Errors
 /// [`CrustError::Unwritable`] when `map` is not a finite invertible affine map, when a
@@ -273,6 +290,7 @@ fn finalize_polygons(
             num_merged_vertices: 0,
             merge_distance: 0.0,
             num_separated_vertices: 0,
+            topology_before: None,
         });
     }
     // Rounding broke nothing: the mapped mesh itself.
@@ -284,6 +302,7 @@ fn finalize_polygons(
                 num_merged_vertices: 0,
                 merge_distance: 0.0,
                 num_separated_vertices: 0,
+                topology_before: None,
             });
         }
     }
@@ -317,22 +336,20 @@ fn finalize_polygons(
         ))
     };
     match attempt(&polygons, &out.positions, &target) {
-        Ok((built, check, num_separated))
-            if expect.is_none_or(|(c, g)| (check.report.num_components, check.report.genus) == (c, Some(g))) =>
-        {
+        // Every reader welds coincident positions, so a topology that welding changes is
+        // the file's whatever is done (a handle or gap thinner than the floats' spacing).
+        Ok((built, check, num_separated)) => {
+            let topology_before =
+                expect.filter(|&(c, g)| (check.report.num_components, check.report.genus) != (c, Some(g)));
             Ok(Finalized {
                 mesh: compact(built.mesh),
                 check,
                 num_merged_vertices: num_welded,
                 merge_distance: 0.0,
                 num_separated_vertices: num_separated,
+                topology_before,
             })
         }
-        Ok((_, check, _)) => Err(unwritable(CrustError::Internal(format!(
-            "welding the vertices that rounding makes coincident changes the topology from {:?} to {} component(s) \
-             of genus {:?}",
-            expect, check.report.num_components, check.report.genus
-        )))),
         Err(first) => {
             let o = resolve(&polygons, &out.positions, &target, first, expect).map_err(unwritable)?;
             Ok(Finalized {
@@ -341,6 +358,7 @@ fn finalize_polygons(
                 num_merged_vertices: num_welded + o.num_merged,
                 merge_distance: o.merge_distance,
                 num_separated_vertices: o.num_separated,
+                topology_before: o.topology_before,
             })
         }
     }

@@ -60,7 +60,17 @@ pub(crate) struct Outcome {
     pub merge_distance: f64,
     /// Vertices moved apart from a coincident copy.
     pub num_separated: usize,
+    /// Components and genus before the repair, when merging vertices at most
+    /// [`TOPOLOGY_SLACK_UNITS`] apart changed them (a handle or a gap thinner than a few
+    /// units in the last place of the output closed).
+    pub topology_before: Option<(usize, i64)>,
 }
+
+/// Merging vertices this many units in the last place apart (or fewer) may change the
+/// topology: a handle or a gap that thin cannot be kept apart by the output's floats (it
+/// is what rounding does to it), and refusing to write the crust would be worse. Merges
+/// over longer edges that change the topology are refused: they would collapse features.
+pub(crate) const TOPOLOGY_SLACK_UNITS: f64 = 4.0;
 
 /// Why an attempt failed: a message, and the polygon vertices at fault (`None`: all).
 pub(crate) struct Failure {
@@ -153,8 +163,9 @@ pub(crate) fn attempt(
 /// # Errors
 /// [`CrustError::Internal`] naming the last defect when no merge distance up to
 /// `target.max_merge` of the mesh's largest extent gives a valid mesh, or when the only
-/// valid meshes found change the number of components or the genus of `first` (then the
-/// merging would have collapsed real features, not rounding noise).
+/// valid meshes found change the number of components or the genus of `first` by merging
+/// vertices more than [`TOPOLOGY_SLACK_UNITS`] apart (then the merging would have collapsed
+/// real features, not rounding noise).
 pub(crate) fn resolve(
     polygons: &[Vec<u32>],
     positions: &[V],
@@ -214,8 +225,11 @@ pub(crate) fn resolve(
             match attempt(&loops, positions, target) {
                 Ok((built, check, num_separated)) => {
                     let got = (check.report.num_components, check.report.genus);
+                    let mut topology_before = None;
                     if let Some((c, g)) = expect {
-                        if got != (c, Some(g)) {
+                        if got != (c, Some(g)) && tol <= TOPOLOGY_SLACK_UNITS * unit {
+                            topology_before = Some((c, g));
+                        } else if got != (c, Some(g)) {
                             return Err(CrustError::Internal(format!(
                                 "rounding the crust's vertices breaks it, and the merging that repairs it \
                                  (vertices up to {tol:.3e} apart) changes its topology from {c} component(s) of \
@@ -225,7 +239,14 @@ pub(crate) fn resolve(
                         }
                     }
                     let num_merged = rep.iter().enumerate().filter(|&(v, &r)| r as usize != v).count();
-                    return Ok(Outcome { built, check, num_merged, merge_distance: tol, num_separated });
+                    return Ok(Outcome {
+                        built,
+                        check,
+                        num_merged,
+                        merge_distance: tol,
+                        num_separated,
+                        topology_before,
+                    });
                 }
                 Err(f) => {
                     mark(&mut bad, &f);

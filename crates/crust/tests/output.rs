@@ -234,3 +234,41 @@ fn glb_and_ply_of_the_reference_cases_agree() {
     let f = finalize(&c, FrameMap::Identity, Precision::F64).unwrap();
     assert!((f.check.report.signed_volume - 0.5).abs() < 1e-12, "{}", f.check.report.signed_volume);
 }
+
+/// Frozen cases from the main job on `../shared/meshes/mikedh__soup.stl` (sites near the
+/// failure cut out of its sites file, so the crust there is the one the full run made),
+/// which once failed as float32 GLB with "the crust cannot be written".
+fn soup_case(name: &str) -> (Crust, [[f64; 4]; 4]) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name);
+    let file = crust::SitesFile::read(&path).unwrap();
+    (Crust::extract(&file.sites, &file.inside, &CrustConfig::default()).unwrap(), file.transform)
+}
+
+#[test]
+fn a_nearly_straight_corner_is_not_the_middle_of_a_sliver() {
+    // 311 sites: Voronoi faces with corners all but straight. Fans from a fixed corner made
+    // those corners the middle of slivers thinner than a float32 step, which folded onto
+    // their neighbours once rounded; the best-shaped triangulation uses them as apexes.
+    let (c, m) = soup_case("soup_f32_sliver.sites.npz");
+    let f = finalize(&c, m, Precision::F32).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(f.topology_before, None);
+    assert_eq!((f.check.report.num_components, f.check.report.genus), (1, Some(5)));
+    write_and_reread(&f.mesh, "sliver.glb");
+    write_and_reread(&finalize(&c, m, Precision::F64).unwrap().mesh, "sliver.ply");
+}
+
+#[test]
+fn a_handle_thinner_than_float32_closes_and_is_reported() {
+    // 425 sites whose exact crust has a handle about one float32 step thick: it cannot stay
+    // open in the file, so the merge closes it and says so, instead of refusing to write.
+    let (c, m) = soup_case("soup_f32_thin_handle.sites.npz");
+    assert_eq!((c.check.report.num_components, c.check.report.genus), (1, Some(22)));
+    let f = finalize(&c, m, Precision::F32).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(f.topology_before, Some((1, 22)));
+    assert_eq!((f.check.report.num_components, f.check.report.genus), (1, Some(21)));
+    assert!(f.merge_distance <= 4.0 * 2f64.powi(-23) * 1.2, "{}", f.merge_distance);
+    write_and_reread(&f.mesh, "handle.glb");
+    // In float64 nothing is that thin: the exact topology.
+    let f = finalize(&c, m, Precision::F64).unwrap();
+    assert_eq!((f.topology_before, f.check.report.genus), (None, Some(22)));
+}

@@ -162,6 +162,10 @@ pub struct CrustReport {
     /// Split-vertex copies moved a few ulps apart in the output (so readers that weld
     /// coincident vertices keep the mesh manifold).
     pub num_separated_in_output: usize,
+    /// Components and genus of the exact crust when rounding to the output's floats
+    /// changed them (a handle or gap thinner than a few units in the last place closed);
+    /// `null` when the file has the exact crust's topology.
+    pub topology_before_rounding: Option<(usize, i64)>,
     /// Vertices.
     pub num_vertices: usize,
     /// Triangles.
@@ -324,7 +328,7 @@ impl FitReport {
         format!(
             "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
              misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{} Crust: {} triangles, {} component(s), \
-             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{} {}{}",
+             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{}{} {}{}",
             self.input.path,
             t.num_sites,
             inside_trainable,
@@ -347,6 +351,7 @@ impl FitReport {
             c.num_components,
             c.genus.map_or("n/a".to_string(), |g| g.to_string()),
             c.volume,
+            crust::output::topology_note(c.topology_before_rounding).map_or(String::new(), |n| format!(" {n}")),
             shell,
             metrics,
             target

@@ -357,6 +357,7 @@ fn crust_report(checked: &CheckedCrust, mesh: &TriMesh, num_projected: usize) ->
         num_merged_vertices: checked.crust.stats.num_merged_vertices,
         num_merged_in_output: checked.written.num_merged_vertices,
         num_separated_in_output: checked.written.num_separated_vertices,
+        topology_before_rounding: checked.written.topology_before,
         num_vertices: mesh.positions.len(),
         num_triangles: mesh.triangles.len(),
         num_components: r.num_components,
