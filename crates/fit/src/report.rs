@@ -307,6 +307,15 @@ impl FitReport {
             ),
             _ => String::new(),
         };
+        let interior = match (self.solid.interior_surface_share, self.solid.interior_surface_samples_dropped) {
+            (Some(share), dropped) if dropped > 0 => format!(
+                " {:.1}% of the input's surface is not on the solid's boundary (the same side of the solid on \
+                 both sides: faces inside it where bodies overlap, doubled faces); its {dropped} surface samples were \
+                 left out of the initialisation, the surface term and the polish.",
+                100.0 * share
+            ),
+            _ => String::new(),
+        };
         let target = match &self.accuracy_target {
             Some(a) => {
                 let steps: Vec<String> = a
@@ -327,7 +336,7 @@ impl FitReport {
         };
         format!(
             "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
-             misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{} Crust: {} triangles, {} component(s), \
+             misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{}{} Crust: {} triangles, {} component(s), \
              genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{}{} {}{}",
             self.input.path,
             t.num_sites,
@@ -345,6 +354,7 @@ impl FitReport {
             100.0 * q.misclassification_ci95[0][1],
             100.0 * q.misclassification_uniform,
             100.0 * q.misclassification_near_surface,
+            interior,
             polished,
             carved,
             c.num_triangles,
