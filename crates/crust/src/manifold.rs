@@ -363,12 +363,13 @@ fn triangulate(ids: &[u32], positions: &[V], taken: &HashSet<(u32, u32)>, out: &
     true
 }
 
-/// Shape of a triangle: twice its area over its longest edge squared (2·height/base over
-/// the longest edge; at most √3/2·… for the equilateral, 0 for a degenerate one), in f64.
-/// Only ranks triangulations; validity is decided exactly.
+/// Shape of a triangle: twice its area over its longest edge squared (the height over
+/// the longest edge as a share of that edge: √3/2 for the equilateral, 0 for a degenerate
+/// one), in f64. Only ranks triangulations; validity is decided exactly.
 fn shape(positions: &[V], a: u32, b: u32, c: u32) -> f64 {
     let [pa, pb, pc] = [a, b, c].map(|v| positions[v as usize]);
-    let area2 = dot(cross(sub(pb, pa), sub(pc, pa)), cross(sub(pb, pa), sub(pc, pa))).sqrt();
+    let n = cross(sub(pb, pa), sub(pc, pa));
+    let area2 = dot(n, n).sqrt();
     let longest = [sub(pb, pa), sub(pc, pb), sub(pa, pc)].iter().map(|e| dot(*e, *e)).fold(0.0f64, f64::max);
     if longest > 0.0 {
         area2 / longest

@@ -226,10 +226,10 @@ pub(crate) fn resolve(
                 Ok((built, check, num_separated)) => {
                     let got = (check.report.num_components, check.report.genus);
                     let mut topology_before = None;
-                    if let Some((c, g)) = expect {
-                        if got != (c, Some(g)) && tol <= TOPOLOGY_SLACK_UNITS * unit {
+                    if let Some((c, g)) = expect.filter(|&(c, g)| got != (c, Some(g))) {
+                        if tol <= TOPOLOGY_SLACK_UNITS * unit {
                             topology_before = Some((c, g));
-                        } else if got != (c, Some(g)) {
+                        } else {
                             return Err(CrustError::Internal(format!(
                                 "rounding the crust's vertices breaks it, and the merging that repairs it \
                                  (vertices up to {tol:.3e} apart) changes its topology from {c} component(s) of \

@@ -109,21 +109,21 @@ fn drop_interior_surface(solid: &dyn Solid, data: &mut TrainingData, diagonal: f
         // A sample without a normal (degenerate face) cannot be probed: kept.
         range.zip(labels.chunks_exact(2)).map(|(i, l)| l[0] == l[1] && data.normals[i] != [0.0; 3]).collect()
     };
-    let probe = interior(0..n.min(INTERIOR_PROBE));
-    let probe_share = probe.iter().filter(|&&b| b).count() as f64 / probe.len() as f64;
+    let first = n.min(INTERIOR_PROBE);
+    let mut all = interior(0..first);
+    let probe_share = all.iter().filter(|&&b| b).count() as f64 / first as f64;
     if probe_share < INTERIOR_MIN_SHARE {
         return (probe_share, 0);
     }
-    let all = interior(0..n);
+    all.extend(interior(first..n));
     let dropped = all.iter().filter(|&&b| b).count();
     let share = dropped as f64 / n as f64;
     if n - dropped < n / 100 {
         return (share, 0);
     }
-    let mut keep = all.iter().map(|&b| !b);
-    data.surface.retain(|_| keep.next().unwrap_or(true));
-    let mut keep = all.iter().map(|&b| !b);
-    data.normals.retain(|_| keep.next().unwrap_or(true));
+    let kept = |v: &[[f64; 3]]| v.iter().zip(&all).filter(|(_, &b)| !b).map(|(p, _)| *p).collect();
+    data.surface = kept(&data.surface);
+    data.normals = kept(&data.normals);
     (share, dropped)
 }
 
