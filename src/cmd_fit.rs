@@ -132,6 +132,11 @@ pub struct Args {
     /// No site insertion after training.
     #[arg(long, conflicts_with = "carve")]
     pub no_carve: bool,
+    /// Keep every site (default: last, the sites whose Delaunay neighbours all carry their
+    /// label are removed; they change neither the crust nor the occupancy; off with
+    /// --preset paper).
+    #[arg(long)]
+    pub no_prune: bool,
     /// Steps of the surface polish after training (VoroMesh's bisector loss pulls the
     /// diagram's faces onto surface samples; default 400, 0 or --no-polish: none; off with
     /// --preset paper unless given).
@@ -223,6 +228,7 @@ fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
         no_relabel: args.no_relabel,
         carve: args.carve,
         no_carve: args.no_carve,
+        no_prune: args.no_prune,
         skip_metrics: false,
         no_polish: args.no_polish,
         polish_steps: args.polish_steps,

@@ -85,6 +85,15 @@ fn default_bunny_fit_meets_the_accuracy_target() {
     assert!(mis <= 0.01, "misclassification's 95% upper end {mis}");
     assert_eq!(r["crust"]["is_closed"], true);
     assert_eq!(r["crust"]["genus"], 0);
+    // The sites that change nothing were removed last: what the sites file holds is what the
+    // crust was read from, and it is fewer than K trainable, boundary and inserted sites.
+    let p = &r["pruning"];
+    let (before, after) = (p["sites_before"].as_u64().unwrap(), p["sites_after"].as_u64().unwrap());
+    assert!(after < before, "{p}");
+    assert_eq!(r["crust"]["num_sites"].as_u64(), Some(after));
+    let file = crust::SitesFile::read(&out.with_extension("sites.npz")).unwrap();
+    assert_eq!(file.sites.len() as u64, after);
+    assert!(after <= r["settings"]["train"]["num_sites"].as_u64().unwrap(), "{p}");
     keep_for_validator(&out, "bunny-default");
 }
 

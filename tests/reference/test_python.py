@@ -22,7 +22,7 @@ import igl
 import numpy as np
 import pytest
 import trimesh
-from scipy.spatial import Delaunay
+from scipy.spatial import Delaunay, cKDTree
 
 import voronoi_fit as vf
 
@@ -86,6 +86,26 @@ def test_crust_of_the_fit_sites(fitted):
     m, m2 = trimesh.Trimesh(V, F, process=False), trimesh.Trimesh(V2, F2, process=False)
     assert m2.is_watertight and m2.is_winding_consistent
     assert abs(m2.volume - m.volume) <= 1e-6 * abs(m.volume)
+
+
+def test_pruning_changes_neither_the_crust_nor_the_occupancy(bunny, fitted):
+    # The same fit keeping every site: the sites removed last had only neighbours of their
+    # own label, so the crust (as a surface: volume, area) and the nearest-site labels
+    # (scipy's k-d tree) are the same.
+    full = vf.fit(bunny, progress=False, float32=False, prune=False, **SMALL)
+    assert full.report["pruning"] is None
+    pruning = fitted.report["pruning"]
+    assert len(fitted.sites) == pruning["sites_after"] < pruning["sites_before"] == len(full.sites)
+    m = trimesh.Trimesh(fitted.crust_vertices, fitted.crust_faces, process=False)
+    m_full = trimesh.Trimesh(full.crust_vertices, full.crust_faces, process=False)
+    assert abs(m.volume - m_full.volume) <= 1e-9 * abs(m_full.volume)
+    assert abs(m.area - m_full.area) <= 1e-9 * m_full.area
+    rng = np.random.default_rng(3)
+    points = rng.random((200_000, 3))
+    near = np.repeat(full.sites_unit, 4, axis=0) + rng.normal(scale=0.01, size=(4 * len(full.sites_unit), 3))
+    points = np.vstack([points, near])
+    label = lambda r: r.labels[cKDTree(r.sites_unit).query(points)[1]]
+    assert np.array_equal(label(fitted), label(full))
 
 
 def test_winding_numbers_and_distances_equal_libigl(bunny):

@@ -376,7 +376,7 @@ fn face_polygon(
     Ok(Some(poly))
 }
 
-fn check_inputs(sites: &[[f64; 3]], inside: &[bool], config: &CrustConfig) -> Result<(), CrustError> {
+pub(crate) fn check_inputs(sites: &[[f64; 3]], inside: &[bool], config: &CrustConfig) -> Result<(), CrustError> {
     if sites.len() != inside.len() {
         return Err(CrustError::LengthMismatch { num_sites: sites.len(), num_labels: inside.len() });
     }
@@ -421,7 +421,10 @@ fn circumcenter_f64(c: [[f64; 3]; 4]) -> Option<[f64; 3]> {
 /// and their neighbours exactly cospherical, so box-face vertices merge exactly instead
 /// of splitting into ulp-sized slivers. Sites move by at most g/2 (2^-52 ≈ 2.2e-16 in the
 /// unit cube).
-fn snap_to_grid(sites: &[[f64; 3]], config: &CrustConfig) -> Result<(Vec<[f64; 3]>, CrustConfig), CrustError> {
+pub(crate) fn snap_to_grid(
+    sites: &[[f64; 3]],
+    config: &CrustConfig,
+) -> Result<(Vec<[f64; 3]>, CrustConfig), CrustError> {
     let m = config.box_lo.iter().chain(&config.box_hi).fold(0.0f64, |a, &b| a.max(b.abs()));
     let e = if m == 0.0 { 0 } else { m.log2().floor() as i32 + 1 };
     let g = 2f64.powi(e - 51);

@@ -22,6 +22,7 @@ mod extract;
 mod manifold;
 pub mod output;
 pub mod planar;
+pub mod prune;
 mod resolve;
 mod sites_file;
 

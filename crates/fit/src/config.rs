@@ -142,6 +142,11 @@ pub struct FitConfig {
     /// from the input ([`crate::carve`]; default 0.3%, up to K/8 sites in eight rounds);
     /// `None`: off.
     pub carve: Option<f64>,
+    /// Last, remove the sites that change neither the crust nor the nearest-site occupancy
+    /// (every Delaunay neighbour carries their label; [`crust::prune`]): boundary sites,
+    /// sites deep inside or far outside. Default on; off with the paper preset
+    /// (`--no-prune`).
+    pub prune: bool,
     /// Skip the metrics against the input (Hausdorff, Chamfer, IoU): for callers that
     /// measure themselves.
     pub skip_metrics: bool,
@@ -175,6 +180,7 @@ impl FitConfig {
             train_shell: false,
             relabel: true,
             carve: Some(DEFAULT_CARVE),
+            prune: true,
             refine: None,
             skip_metrics: false,
             polish: Some(soft_voronoi::PolishConfig::default_for(num_sites, 0)),

@@ -21,7 +21,7 @@ pub struct FitOptions {
     /// Seed of the samples, the initialisation and the batches.
     pub seed: u64,
     /// `default` or `paper` (the seed paper's setting: no polish, no relabelling, no
-    /// insertion).
+    /// insertion, no pruning).
     pub preset: Option<String>,
     /// Initialisation.
     pub init: Option<Init>,
@@ -57,6 +57,8 @@ pub struct FitOptions {
     pub carve: Option<f64>,
     /// No carving.
     pub no_carve: bool,
+    /// Keep the sites that change neither the crust nor the occupancy.
+    pub no_prune: bool,
     /// Skip the metrics against the input (faster; the report says so).
     pub skip_metrics: bool,
     /// No surface polish after training (the paper preset has none either).
@@ -87,6 +89,7 @@ impl FitOptions {
         // The paper preset is the paper's method: no polish, no relabelling, no insertion.
         c.relabel = !self.no_relabel && !paper;
         c.carve = if self.no_carve || (paper && self.carve.is_none()) { None } else { self.carve.or(c.carve) };
+        c.prune = !self.no_prune && !paper;
         c.eval.samples = self.eval_samples.unwrap_or(c.eval.samples);
         c.preset = preset.to_string();
         c.skip_metrics = self.skip_metrics;

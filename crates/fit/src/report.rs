@@ -149,7 +149,7 @@ pub struct QualityReport {
 /// The crust as written (every figure is of the mesh in the output file).
 #[derive(Clone, Debug, Serialize)]
 pub struct CrustReport {
-    /// Sites (trainable and boundary).
+    /// Sites in the sites file: trainable, boundary and inserted, less the pruned ones.
     pub num_sites: usize,
     /// Inside sites.
     pub num_inside: usize,
@@ -182,6 +182,19 @@ pub struct CrustReport {
     pub self_intersections: usize,
     /// Volume, input units³.
     pub volume: f64,
+}
+
+/// Report field `pruning`: the sites removed last because every Delaunay neighbour
+/// carries their label, so neither the crust nor the nearest-site occupancy changes
+/// ([`crust::prune`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct PruneReport {
+    /// Sites removed in each round (an independent set each).
+    pub removed_per_round: Vec<usize>,
+    /// Sites before: trainable, boundary and inserted.
+    pub sites_before: usize,
+    /// Sites after: what the sites file holds.
+    pub sites_after: usize,
 }
 
 /// Paths of the files written (filled in by the writer, e.g. the CLI).
@@ -247,6 +260,9 @@ pub struct FitReport {
     pub relabelled_sites: Option<usize>,
     /// Sites inserted where the crust strayed from the input (absent when off).
     pub carving: Option<crate::carve::CarveReport>,
+    /// Sites removed last because they change neither the crust nor the occupancy (absent
+    /// when off).
+    pub pruning: Option<PruneReport>,
     /// The accuracy target's goal and error-against-K trace, when one was asked for.
     pub accuracy_target: Option<crate::grow::AccuracyReport>,
     /// Files written (empty until a writer fills them in).
@@ -275,7 +291,6 @@ impl FitReport {
             MetricsReport::Failed { error } => format!("Metrics against the input failed: {error}."),
             MetricsReport::Skipped { .. } => String::new(),
         };
-        let inside_trainable = c.num_inside;
         let inserted: usize = self.carving.as_ref().map_or(0, |r| r.inserted_per_round.iter().sum());
         let carved = match &self.carving {
             Some(r) if inserted > 0 => format!(
@@ -316,6 +331,15 @@ impl FitReport {
             ),
             _ => String::new(),
         };
+        let pruned = match &self.pruning {
+            Some(p) if p.sites_after < p.sites_before => format!(
+                " Last, {} sites whose Delaunay neighbours all carry their label were removed (they change neither \
+                 the crust nor the occupancy): the sites file holds {} sites.",
+                p.sites_before - p.sites_after,
+                p.sites_after
+            ),
+            _ => String::new(),
+        };
         let target = match &self.accuracy_target {
             Some(a) => {
                 let steps: Vec<String> = a
@@ -335,13 +359,13 @@ impl FitReport {
             None => String::new(),
         };
         format!(
-            "{}: fitted {} sites ({} inside, {} fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
-             misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{}{} Crust: {} triangles, {} component(s), \
+            "{}: fitted {} sites ({} more fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
+             misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{}{}{} Crust of \
+             {} sites ({} inside): {} triangles, {} component(s), \
              genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{}{} {}{}",
             self.input.path,
             t.num_sites,
-            inside_trainable,
-            c.num_sites - t.num_sites - inserted,
+            self.settings.train.num_boundary(),
             t.steps,
             match &self.losses.selected {
                 Some(b) if b.step < t.steps =>
@@ -357,6 +381,9 @@ impl FitReport {
             interior,
             polished,
             carved,
+            pruned,
+            c.num_sites,
+            c.num_inside,
             c.num_triangles,
             c.num_components,
             c.genus.map_or("n/a".to_string(), |g| g.to_string()),

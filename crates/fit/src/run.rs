@@ -160,6 +160,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         }
         None => None,
     };
+    let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
     let checked = crust_of(&sites, &labels, &p.transform, config.output_precision)?;
     let crust_mesh = checked.written.mesh.clone();
     timings.crust = lap.next();
@@ -214,6 +215,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         polish,
         relabelled_sites: config.relabel.then_some(num_relabelled),
         carving,
+        pruning,
         accuracy_target: None,
         outputs: OutputsReport::default(),
         total_seconds: t_all.elapsed().as_secs_f64(),
@@ -313,6 +315,20 @@ fn relabel(sites: &[[f64; 3]], labels: &mut [bool], k: usize, solid: &dyn Solid)
     }
     changed
 }
+
+/// Removes the sites that change neither the crust nor the nearest-site occupancy
+/// ([`crust::prune::prune`], up to [`PRUNE_ROUNDS`] rounds).
+fn prune(sites: &mut Vec<[f64; 3]>, labels: &mut Vec<bool>) -> Result<PruneReport, FitError> {
+    let before = sites.len();
+    let r = crust::prune::prune(sites, labels, 0, PRUNE_ROUNDS, &crust::CrustConfig::default())
+        .map_err(|e| FitError::Failure(format!("removing the sites that change nothing: {e}")))?;
+    Ok(PruneReport { removed_per_round: r.removed_per_round, sites_before: before, sites_after: sites.len() })
+}
+
+/// Rounds of [`prune`]: each removes an independent set, about a third fewer than the
+/// round before (bunny.ply: 460, 319, 214, 149, 96, 62, 40, 31 of the 1,433 that sixteen
+/// rounds remove), at about 0.12 s a round for 8k sites.
+pub const PRUNE_ROUNDS: usize = 8;
 
 /// Misclassification of the hard Voronoi occupancy on a fresh pool (another seed stream
 /// than training: seed XOR [`vf_common::rng::seed_tweak::EVALUATION`]).

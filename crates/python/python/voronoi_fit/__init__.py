@@ -252,6 +252,7 @@ def fit(
     seed: int = 0,
     relabel: bool = True,
     carve: "float | bool" = True,
+    prune: bool = True,
     progress: "Callable[[str, int, int, float], Any] | bool | None" = None,
     name: Optional[str] = None,
     float32: bool = True,
@@ -272,6 +273,8 @@ def fit(
             polish_steps=0: the polish ignores labels).
         carve: True (default tolerance, 0.3% of the diagonal), a share of the diagonal, or
             False for no site insertion.
+        prune: last, remove the sites whose Delaunay neighbours all carry their label
+            (they change neither the crust nor the occupancy); False keeps every site.
         progress: a callable ``progress(stage, step, steps, loss)``; None shows a tqdm bar
             when tqdm is installed and stderr is a terminal; False shows nothing. An
             exception raised by the callable, or Ctrl-C, stops the fit and is raised.
@@ -299,6 +302,7 @@ def fit(
     opts["sites"] = int(sites)
     opts["seed"] = int(seed)
     opts["no_relabel"] = not relabel
+    opts["no_prune"] = not prune
     if carve is False:
         opts["no_carve"] = True
     elif carve is not True:

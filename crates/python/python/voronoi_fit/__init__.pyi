@@ -40,6 +40,7 @@ def fit(
     seed: int = 0,
     relabel: bool = True,
     carve: Union[float, bool] = True,
+    prune: bool = True,
     progress: Union[Progress, bool, None] = None,
     name: Optional[str] = None,
     float32: bool = True,
