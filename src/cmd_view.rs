@@ -71,8 +71,9 @@ pub fn write_picture(
     let name =
         input_path.file_name().map_or_else(|| input_path.display().to_string(), |n| n.to_string_lossy().to_string());
     let title = format!(
-        "{name}: {} sites, {:.2}% misclassified, crust of {} triangles",
+        "{name}: {} sites fitted ({} in the file), {:.2}% misclassified, crust of {} triangles",
         group(report.settings.train.num_sites),
+        group(report.crust.num_sites),
         100.0 * report.quality.misclassification,
         group(report.crust.num_triangles)
     );
@@ -256,6 +257,7 @@ fn summary_html(
     if let Some(r) = report {
         let diag = input.map(|m| m.diagonal());
         rows.push(("sites (trainable)".into(), fmt_num(f("/settings/train/num_sites"), 0)));
+        rows.push(("sites in the file".into(), fmt_num(f("/crust/num_sites"), 0)));
         rows.push(("training steps".into(), fmt_num(f("/settings/train/steps"), 0)));
         rows.push((
             "misclassified".into(),
