@@ -63,4 +63,12 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert_eq!(solid.inside(&sites[n0..]), new_labels);
     assert!(new_labels.chunks(2).all(|p| p[0] != p[1]), "{new_labels:?}");
     assert!(report.farthest_after <= report.farthest_before);
+    // One farthest distance per extraction; the kept one is the least; no more than
+    // PATIENCE rounds ran after the last one that beat the best.
+    let per = &report.farthest_per_round;
+    assert_eq!(per[0], report.farthest_before);
+    assert_eq!(per.iter().copied().fold(f64::INFINITY, f64::min), report.farthest_after);
+    assert_eq!(per.len(), report.inserted_per_round.len() + report.undone_rounds + 1, "{report:?}");
+    let last_best = (0..per.len()).filter(|&i| per[..i].iter().all(|&x| per[i] < x)).max().unwrap();
+    assert!(per.len() - 1 - last_best <= fit::carve::PATIENCE, "{report:?}");
 }
