@@ -27,7 +27,7 @@
 //! that cost file size and no accuracy (the boundary sites on the cube's faces, sites deep
 //! inside or far outside the shape).
 
-use delaunay3::{Delaunay3, DelaunayError, INFINITE};
+use delaunay3::{Delaunay3, DelaunayError};
 
 use crate::error::CrustError;
 use crate::extract::{check_inputs, snap_to_grid};
@@ -147,11 +147,9 @@ impl Neighbours {
         let n = dt.num_inputs();
         let to_input = dt.input_of_vertex_map();
         let mut per_vertex: Vec<Vec<u32>> = vec![Vec::new(); dt.num_vertices()];
+        // `edges` lists the finite edges only.
         for e in dt.edges() {
             let [a, b] = e.vertices;
-            if a == INFINITE || b == INFINITE {
-                continue;
-            }
             per_vertex[a as usize].push(to_input[b as usize]);
             per_vertex[b as usize].push(to_input[a as usize]);
         }
