@@ -7,8 +7,12 @@ use mesh_io::TriMesh;
 
 /// An axis-aligned box [0, a] × [0, b] × [0, c], outward-facing.
 fn cuboid(a: f64, b: f64, c: f64) -> TriMesh {
-    let positions =
-        (0..8).map(|i| [a * (i & 1) as f64, b * ((i >> 1) & 1) as f64, c * ((i >> 2) & 1) as f64]).collect();
+    box_at([0.0; 3], [a, b, c])
+}
+
+/// An axis-aligned box from `lo` to `hi`, outward-facing.
+fn box_at(lo: [f64; 3], hi: [f64; 3]) -> TriMesh {
+    let positions = (0..8).map(|i| [0, 1, 2].map(|k| if (i >> k) & 1 == 1 { hi[k] } else { lo[k] })).collect();
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let triangles = quads.iter().flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
     TriMesh { positions, triangles }
@@ -39,4 +43,40 @@ fn a_thin_plate_starts_with_flat_faces() {
     assert!(inner > 100, "{inner} crust vertices in the plate's middle");
     // Untrained; the rim (the plate's narrow sides) is where the rest of the error is.
     assert!(out.report.quality.misclassification < 0.03, "{}", out.report.quality.misclassification);
+}
+
+/// A 1 × 1 × 0.3 box with a fin 1.6% of the box thick standing on it (two overlapping
+/// bodies, like the benchmark's box_fin). At K = 2,048 the box's creases and the fin's
+/// faces both ask for denser pairs than the allowance holds; the creases once took all of
+/// it and the fin started (and ended) without a single site.
+#[test]
+fn a_thin_fin_keeps_its_sites_at_small_k() {
+    let t = 0.016;
+    let mut mesh = box_at([0.0; 3], [1.0, 1.0, 0.3]);
+    let fin = box_at([0.1, 0.5 - t / 2.0, 0.25], [0.9, 0.5 + t / 2.0, 0.8]);
+    let base = mesh.positions.len() as u32;
+    mesh.positions.extend(fin.positions);
+    mesh.triangles.extend(fin.triangles.iter().map(|t| t.map(|v| v + base)));
+    let mut c = FitConfig::new("box_fin", 2048);
+    c.train.steps = 0;
+    c.carve = None;
+    c.polish = None;
+    c.sampling.samples = 100_000;
+    c.eval.samples = 50_000;
+    let out = fit::fit(&mesh, &c, &mut NoProgress).unwrap();
+    let sites: Vec<[f64; 3]> = out.sites.sites.iter().map(|&p| out.sites.to_mesh_frame(p)).collect();
+    // The occupancy (the nearest site's label) on the fin's middle plane, away from its rim
+    // and from the box.
+    let (mut inside, mut total) = (0, 0);
+    for i in 0..40 {
+        for j in 0..20 {
+            let q = [0.15 + 0.7 * (i as f64 + 0.5) / 40.0, 0.5, 0.35 + 0.4 * (j as f64 + 0.5) / 20.0];
+            let d2 = |p: &[f64; 3]| (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>();
+            let nearest = (0..sites.len()).min_by(|&a, &b| d2(&sites[a]).total_cmp(&d2(&sites[b]))).unwrap();
+            inside += out.sites.inside[nearest] as usize;
+            total += 1;
+        }
+    }
+    assert!(inside as f64 >= 0.9 * total as f64, "{inside} of {total} points of the fin's middle are inside");
+    assert!(out.report.crust.is_closed, "{:?}", out.report.crust);
 }

@@ -205,11 +205,11 @@ pub fn pairs_init_refined(
     // A uniform spacing first, then a cap on each candidate's spacing where the part is
     // thinner (or the surface more folded) than the pairs would be wide there.
     let (_, r0) = poisson_subset(candidates, pairs);
-    let mut cap = feature_caps(candidates, &data.normals[..m], solid, r0, offset);
+    let (mut cap, thin) = feature_caps(candidates, &data.normals[..m], solid, r0, offset);
     for (c, _) in cap.iter_mut().zip(refine).filter(|(_, &r)| r) {
         *c = c.min(0.5 * r0);
     }
-    let (chosen, spacing) = adaptive_subset(candidates, &cap, pairs);
+    let (chosen, spacing) = adaptive_subset(candidates, &cap, &thin, r0, pairs);
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 3);
     let mut delta: Vec<f64> = spacing.iter().map(|&h| offset * h).collect();
     let mut sites = vec![[0.0; 3]; 2 * chosen.len()];
@@ -383,52 +383,95 @@ pub fn poisson_subset(points: &[[f64; 3]], target: usize) -> (Vec<u32>, f64) {
 /// Points of `points`, in order, kept when no kept point lies within `r` (a uniform grid
 /// of cells of side ≥ r over the unit cube, 27 neighbouring cells checked).
 fn greedy_disk(points: &[[f64; 3]], r: f64) -> Vec<u32> {
-    // Cells of side 1/m ≥ r, so a conflict lies in a neighbouring cell.
-    let m = ((1.0 / r).floor() as usize).clamp(1, 256);
-    let cell = |p: [f64; 3]| p.map(|x| ((x * m as f64) as isize).clamp(0, m as isize - 1));
-    let mut head = vec![u32::MAX; m * m * m];
-    let mut next: Vec<u32> = Vec::new();
-    let mut kept: Vec<u32> = Vec::new();
-    let r2 = r * r;
+    greedy_disk_around(&[], points, r)
+}
+
+/// [`greedy_disk`] with `seeds` kept before any of `points` (only indices of `points` are
+/// returned).
+fn greedy_disk_around(seeds: &[[f64; 3]], points: &[[f64; 3]], r: f64) -> Vec<u32> {
+    let mut grid = DiskGrid::new(r);
+    seeds.iter().for_each(|&p| grid.insert(p));
+    let mut kept = Vec::new();
     for (i, &p) in points.iter().enumerate() {
-        let c = cell(p);
-        let mut free = true;
-        'search: for dx in -1..=1isize {
-            for dy in -1..=1isize {
-                for dz in -1..=1isize {
-                    let q = [c[0] + dx, c[1] + dy, c[2] + dz];
-                    if q.iter().any(|&x| x < 0 || x >= m as isize) {
-                        continue;
-                    }
-                    let mut j = head[(q[0] as usize * m + q[1] as usize) * m + q[2] as usize];
-                    while j != u32::MAX {
-                        let o = points[kept[j as usize] as usize];
-                        let d2 = (o[0] - p[0]).powi(2) + (o[1] - p[1]).powi(2) + (o[2] - p[2]).powi(2);
-                        if d2 < r2 {
-                            free = false;
-                            break 'search;
-                        }
-                        j = next[j as usize];
-                    }
-                }
-            }
-        }
-        if free {
-            let h = (c[0] as usize * m + c[1] as usize) * m + c[2] as usize;
-            next.push(head[h]);
-            head[h] = kept.len() as u32;
+        if !grid.any_within(p) {
+            grid.insert(p);
             kept.push(i as u32);
         }
     }
     kept
 }
 
+/// Points in the unit cube bucketed in a uniform grid of cells of side ≥ r, so every point
+/// within r of a query lies in one of the 27 cells around it.
+struct DiskGrid {
+    m: usize,
+    r2: f64,
+    head: Vec<u32>,
+    next: Vec<u32>,
+    placed: Vec<[f64; 3]>,
+}
+
+impl DiskGrid {
+    fn new(r: f64) -> Self {
+        let m = ((1.0 / r).floor() as usize).clamp(1, 256);
+        DiskGrid { m, r2: r * r, head: vec![u32::MAX; m * m * m], next: Vec::new(), placed: Vec::new() }
+    }
+
+    fn cell(&self, p: [f64; 3]) -> [isize; 3] {
+        p.map(|x| ((x * self.m as f64) as isize).clamp(0, self.m as isize - 1))
+    }
+
+    fn slot(&self, c: [isize; 3]) -> usize {
+        (c[0] as usize * self.m + c[1] as usize) * self.m + c[2] as usize
+    }
+
+    fn insert(&mut self, p: [f64; 3]) {
+        let h = self.slot(self.cell(p));
+        self.next.push(self.head[h]);
+        self.head[h] = self.placed.len() as u32;
+        self.placed.push(p);
+    }
+
+    /// Whether a placed point lies strictly within r of `p`.
+    fn any_within(&self, p: [f64; 3]) -> bool {
+        let c = self.cell(p);
+        for dx in -1..=1isize {
+            for dy in -1..=1isize {
+                for dz in -1..=1isize {
+                    let q = [c[0] + dx, c[1] + dy, c[2] + dz];
+                    if q.iter().any(|&x| x < 0 || x >= self.m as isize) {
+                        continue;
+                    }
+                    let mut j = self.head[self.slot(q)];
+                    while j != u32::MAX {
+                        let o = self.placed[j as usize];
+                        let d2 = (o[0] - p[0]).powi(2) + (o[1] - p[1]).powi(2) + (o[2] - p[2]).powi(2);
+                        if d2 < self.r2 {
+                            return true;
+                        }
+                        j = self.next[j as usize];
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
 /// For each surface point p (normal n), the largest spacing h in r0, r0/2, …, r0/16 whose
 /// pair p ± offset·h·n has one site on each side of the solid and p (nearly) closest to
 /// both: infinity where r0 itself passes (no cap), else that h. Thin parts and tight folds
-/// get proportionally more, closer pairs, so they do not grow spikes.
-fn feature_caps(points: &[[f64; 3]], normals: &[[f64; 3]], solid: &dyn Solid, r0: f64, offset: f64) -> Vec<f64> {
+/// get proportionally more, closer pairs, so they do not grow spikes. Also whether each
+/// point is on a part thinner than the r0 pair is wide (both its sites outside).
+fn feature_caps(
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    solid: &dyn Solid,
+    r0: f64,
+    offset: f64,
+) -> (Vec<f64>, Vec<bool>) {
     let mut cap = vec![f64::INFINITY; points.len()];
+    let mut thin = vec![false; points.len()];
     let mut open: Vec<usize> = (0..points.len()).collect();
     let mut h = r0;
     for level in 0..5 {
@@ -450,6 +493,10 @@ fn feature_caps(points: &[[f64; 3]], normals: &[[f64; 3]], solid: &dyn Solid, r0
             let good = a.inside != b.inside
                 && crate::kernel::distance(probes[2 * j], a.closest) >= 0.7 * delta
                 && crate::kernel::distance(probes[2 * j + 1], b.closest) >= 0.7 * delta;
+            if level == 0 {
+                // Both sites outside: the part is thinner than 2δ across p.
+                thin[i] = !a.inside && !b.inside;
+            }
             if good {
                 if level > 0 {
                     cap[i] = h;
@@ -464,15 +511,23 @@ fn feature_caps(points: &[[f64; 3]], normals: &[[f64; 3]], solid: &dyn Solid, r0
     for i in open {
         cap[i] = 2.0 * h;
     }
-    cap
+    (cap, thin)
 }
 
 /// About `target` well-spread points of `points` with their spacing: where `cap` is finite
 /// (thin parts, folds, sharp creases) a Poisson-disk subset at that spacing, one pass per
 /// cap level; elsewhere a Poisson-disk subset at the uniform spacing that makes up the
-/// rest of the count. Thin regions take at most half the budget unless the rest has too few
-/// candidates (their greedy order is random, so truncation thins them evenly).
-fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], target: usize) -> (Vec<u32>, Vec<f64>) {
+/// rest of the count. Capped regions take at most half the budget unless the rest has too
+/// few candidates (a thin plate is all capped region).
+///
+/// The levels are taken widest first until the allowance runs out, so a thin part (the
+/// smallest caps) may get nothing, and a thin part without sites is lost (at K = 2,048 a
+/// box's creases took the whole allowance and its 1%-thick fin started, and ended, without
+/// a site). So then points on parts thinner than the pairs (`thin`) farther than the
+/// uniform spacing `r0` from every point taken get a greedy pass at `r0`, and so do the
+/// other capped points within 2·r0 of those (the part's rim), before the rest of the
+/// surface. Where every thin part already has points, nothing changes.
+fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], thin: &[bool], r0: f64, target: usize) -> (Vec<u32>, Vec<f64>) {
     let mut levels: Vec<f64> = cap.iter().copied().filter(|c| c.is_finite()).collect();
     levels.sort_by(f64::total_cmp);
     levels.dedup();
@@ -503,8 +558,36 @@ fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], target: usize) -> (Vec<u32>
             break;
         }
     }
+    // Thin parts left without points get them at the uniform spacing (they become columns,
+    // which hold at any spacing), then the other capped points within 2·r0 of those (the
+    // part's rim and edges: without pairs there, its inside cells run on past the rim).
+    let thin_ids: Vec<u32> =
+        (0..points.len() as u32).filter(|&i| thin[i as usize] && cap[i as usize].is_finite()).collect();
+    let mut taken: Vec<[f64; 3]> = chosen.iter().map(|&i| points[i as usize]).collect();
+    let pts: Vec<[f64; 3]> = thin_ids.iter().map(|&i| points[i as usize]).collect();
+    let rescued: Vec<[f64; 3]> = greedy_disk_around(&taken, &pts, r0)
+        .into_iter()
+        .map(|j| {
+            chosen.push(thin_ids[j as usize]);
+            spacing.push(r0);
+            pts[j as usize]
+        })
+        .collect();
+    if !rescued.is_empty() {
+        let mut near = DiskGrid::new(2.0 * r0);
+        rescued.iter().for_each(|&p| near.insert(p));
+        let rim: Vec<u32> = (0..points.len() as u32)
+            .filter(|&i| !thin[i as usize] && cap[i as usize].is_finite() && near.any_within(points[i as usize]))
+            .collect();
+        taken.extend_from_slice(&rescued);
+        let pts: Vec<[f64; 3]> = rim.iter().map(|&i| points[i as usize]).collect();
+        for j in greedy_disk_around(&taken, &pts, r0) {
+            chosen.push(rim[j as usize]);
+            spacing.push(r0);
+        }
+    }
     let pts: Vec<[f64; 3]> = free.iter().map(|&i| points[i as usize]).collect();
-    let rest = target - chosen.len();
+    let rest = target.saturating_sub(chosen.len());
     if rest > 0 && !pts.is_empty() {
         let (base, r) = poisson_subset(&pts, rest);
         for j in base {
