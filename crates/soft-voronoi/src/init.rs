@@ -434,6 +434,12 @@ impl DiskGrid {
 
     /// Whether a placed point lies strictly within r of `p`.
     fn any_within(&self, p: [f64; 3]) -> bool {
+        self.count_within(p, 1) > 0
+    }
+
+    /// How many placed points lie strictly within r of `p`, counting up to `limit`.
+    fn count_within(&self, p: [f64; 3], limit: usize) -> usize {
+        let mut count = 0;
         let c = self.cell(p);
         for dx in -1..=1isize {
             for dy in -1..=1isize {
@@ -447,14 +453,17 @@ impl DiskGrid {
                         let o = self.placed[j as usize];
                         let d2 = (o[0] - p[0]).powi(2) + (o[1] - p[1]).powi(2) + (o[2] - p[2]).powi(2);
                         if d2 < self.r2 {
-                            return true;
+                            count += 1;
+                            if count >= limit {
+                                return count;
+                            }
                         }
                         j = self.next[j as usize];
                     }
                 }
             }
         }
-        false
+        count
     }
 }
 
@@ -561,8 +570,25 @@ fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], thin: &[bool], r0: f64, tar
     // Thin parts left without points get them at the uniform spacing (they become columns,
     // which hold at any spacing), then the other capped points within 2·r0 of those (the
     // part's rim and edges: without pairs there, its inside cells run on past the rim).
-    let thin_ids: Vec<u32> =
-        (0..points.len() as u32).filter(|&i| thin[i as usize] && cap[i as usize].is_finite()).collect();
+    // Only where thin points are at least half of the candidates within r0: a part, not a
+    // crease or a hole's rim where the pair happened to cross the solid (pairs rescued
+    // there, with δ far below their spacing, grew spikes on featuretype).
+    let thin_ids: Vec<u32> = {
+        let (mut all, mut thin_grid) = (DiskGrid::new(r0), DiskGrid::new(r0));
+        for (i, &p) in points.iter().enumerate() {
+            all.insert(p);
+            if thin[i] && cap[i].is_finite() {
+                thin_grid.insert(p);
+            }
+        }
+        (0..points.len() as u32)
+            .filter(|&i| thin[i as usize] && cap[i as usize].is_finite())
+            .filter(|&i| {
+                let p = points[i as usize];
+                2 * thin_grid.count_within(p, usize::MAX) >= all.count_within(p, usize::MAX)
+            })
+            .collect()
+    };
     let mut taken: Vec<[f64; 3]> = chosen.iter().map(|&i| points[i as usize]).collect();
     let pts: Vec<[f64; 3]> = thin_ids.iter().map(|&i| points[i as usize]).collect();
     let rescued: Vec<[f64; 3]> = greedy_disk_around(&taken, &pts, r0)
