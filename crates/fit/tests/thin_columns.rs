@@ -5,6 +5,17 @@
 use fit::{FitConfig, NoProgress};
 use mesh_io::TriMesh;
 
+/// The initialisation alone: no training, polish or carving; fewer samples.
+fn untrained(name: &str, k: usize) -> FitConfig {
+    let mut c = FitConfig::new(name, k);
+    c.train.steps = 0;
+    c.carve = None;
+    c.polish = None;
+    c.sampling.samples = 100_000;
+    c.eval.samples = 50_000;
+    c
+}
+
 /// An axis-aligned box [0, a] × [0, b] × [0, c], outward-facing.
 fn cuboid(a: f64, b: f64, c: f64) -> TriMesh {
     box_at([0.0; 3], [a, b, c])
@@ -22,13 +33,7 @@ fn box_at(lo: [f64; 3], hi: [f64; 3]) -> TriMesh {
 fn a_thin_plate_starts_with_flat_faces() {
     let t = 0.02;
     let plate = cuboid(1.0, 1.0, t);
-    let mut c = FitConfig::new("plate", 2048);
-    c.train.steps = 0;
-    c.carve = None;
-    c.polish = None;
-    c.sampling.samples = 100_000;
-    c.eval.samples = 50_000;
-    let out = fit::fit(&plate, &c, &mut NoProgress).unwrap();
+    let out = fit::fit(&plate, &untrained("plate", 2048), &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, fit::SolidRule::Winding);
     assert!(out.report.crust.is_closed && out.report.crust.num_components == 1, "{:?}", out.report.crust);
     // Away from the rim, every crust vertex lies on one of the two faces.
@@ -57,13 +62,7 @@ fn a_thin_fin_keeps_its_sites_at_small_k() {
     let base = mesh.positions.len() as u32;
     mesh.positions.extend(fin.positions);
     mesh.triangles.extend(fin.triangles.iter().map(|t| t.map(|v| v + base)));
-    let mut c = FitConfig::new("box_fin", 2048);
-    c.train.steps = 0;
-    c.carve = None;
-    c.polish = None;
-    c.sampling.samples = 100_000;
-    c.eval.samples = 50_000;
-    let out = fit::fit(&mesh, &c, &mut NoProgress).unwrap();
+    let out = fit::fit(&mesh, &untrained("box_fin", 2048), &mut NoProgress).unwrap();
     let sites: Vec<[f64; 3]> = out.sites.sites.iter().map(|&p| out.sites.to_mesh_frame(p)).collect();
     // The occupancy (the nearest site's label) on the fin's middle plane, away from its rim
     // and from the box.

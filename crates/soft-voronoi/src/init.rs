@@ -532,10 +532,11 @@ fn feature_caps(
 /// The levels are taken widest first until the allowance runs out, so a thin part (the
 /// smallest caps) may get nothing, and a thin part without sites is lost (at K = 2,048 a
 /// box's creases took the whole allowance and its 1%-thick fin started, and ended, without
-/// a site). So then points on parts thinner than the pairs (`thin`) farther than the
-/// uniform spacing `r0` from every point taken get a greedy pass at `r0`, and so do the
-/// other capped points within 2·r0 of those (the part's rim), before the rest of the
-/// surface. Where every thin part already has points, nothing changes.
+/// a site). So then points on parts thinner than the pairs (`thin`, and at least half of
+/// the candidates within `r0`) farther than the uniform spacing `r0` from every point taken
+/// get a greedy pass at `r0`, and so do the other capped points within 2·r0 of those (the
+/// part's rim), before the rest of the surface. Where every thin part already has points,
+/// nothing changes.
 fn adaptive_subset(points: &[[f64; 3]], cap: &[f64], thin: &[bool], r0: f64, target: usize) -> (Vec<u32>, Vec<f64>) {
     let mut levels: Vec<f64> = cap.iter().copied().filter(|c| c.is_finite()).collect();
     levels.sort_by(f64::total_cmp);
