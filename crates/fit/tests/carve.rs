@@ -63,12 +63,41 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert_eq!(solid.inside(&sites[n0..]), new_labels);
     assert!(new_labels.chunks(2).all(|p| p[0] != p[1]), "{new_labels:?}");
     assert!(report.farthest_after <= report.farthest_before);
-    // One farthest distance per extraction; the kept one is the least; no more than
-    // PATIENCE rounds ran after the last one that beat the best.
+    // One farthest distance per extraction on each side; the kept state's two-sided one
+    // (the Hausdorff distance) is within 1% of the least and no larger than before carving;
+    // no more than PATIENCE rounds ran after the last one that beat the best.
     let per = &report.farthest_per_round;
+    let input = &report.input_farthest_per_round;
+    assert_eq!(per.len(), input.len());
     assert_eq!(per[0], report.farthest_before);
-    assert_eq!(per.iter().copied().fold(f64::INFINITY, f64::min), report.farthest_after);
     assert_eq!(per.len(), report.inserted_per_round.len() + report.undone_rounds + 1, "{report:?}");
-    let last_best = (0..per.len()).filter(|&i| per[..i].iter().all(|&x| per[i] < x)).max().unwrap();
+    let kept = report.inserted_per_round.len();
+    assert_eq!(per[kept], report.farthest_after);
+    let two_sided: Vec<f64> = per.iter().zip(input).map(|(a, b)| a.max(*b)).collect();
+    let least = two_sided.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(two_sided[kept] <= least * 1.01 && two_sided[kept] <= two_sided[0], "{report:?}");
+    // Carving cuts the spike and leaves no dent: the input's side is not farther than before.
+    assert!(input[kept] <= input[0] * 1.01 + 1e-4, "{report:?}");
+    let last_best = (0..per.len()).filter(|&i| two_sided[..i].iter().all(|&x| two_sided[i] < x)).max().unwrap();
     assert!(per.len() - 1 - last_best <= fit::carve::PATIENCE, "{report:?}");
+}
+
+/// A pair at a foot near a convex edge: the site that would sit by the other face (nearer
+/// the input than half the offset) is left out, the other kept; a foot in the middle of a
+/// face, or on the edge with the pair along the bisecting direction, keeps both.
+#[test]
+fn sites_that_would_stand_by_another_face_are_left_out() {
+    let unit = mesh_io::shapes::cuboid([0.3; 3], [0.7; 3]);
+    let oracle = MeshOracle::from_mesh(&unit, &occupancy::Config::default()).unwrap();
+    let t = 0.004;
+    let pair = |c: [f64; 3], n: [f64; 3]| [1.0, -1.0].map(|s| [0, 1, 2].map(|i| c[i] + s * t * n[i])).to_vec();
+    // On the top face, 0.3 t from the edge x = 0.7, the pair along the face's normal: the
+    // inside site would be 0.3 t from the side face x = 0.7 (featuretype's counterbore).
+    let near_edge = pair([0.7 - 0.3 * t, 0.5, 0.7], [0.0, 0.0, 1.0]);
+    assert_eq!(fit::carve::clear_of_the_input(&oracle, near_edge.clone(), t).unwrap(), vec![near_edge[0]]);
+    let middle = pair([0.5, 0.5, 0.7], [0.0, 0.0, 1.0]);
+    assert_eq!(fit::carve::clear_of_the_input(&oracle, middle.clone(), t).unwrap(), middle);
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let on_edge = pair([0.7, 0.5, 0.7], [h, 0.0, h]);
+    assert_eq!(fit::carve::clear_of_the_input(&oracle, on_edge.clone(), t).unwrap(), on_edge);
 }

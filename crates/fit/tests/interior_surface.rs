@@ -4,15 +4,8 @@
 //! surface that was.
 
 use fit::{FitConfig, NoProgress};
+use mesh_io::shapes::cuboid;
 use mesh_io::TriMesh;
-
-/// An axis-aligned box [lo, hi], outward-facing.
-fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> TriMesh {
-    let positions = (0..8).map(|i| [0, 1, 2].map(|c| if (i >> c) & 1 == 1 { hi[c] } else { lo[c] })).collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let triangles = quads.iter().flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-    TriMesh { positions, triangles }
-}
 
 fn concat(a: &TriMesh, b: &TriMesh) -> TriMesh {
     let n = a.positions.len() as u32;

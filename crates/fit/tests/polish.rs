@@ -6,12 +6,7 @@ use mesh_io::TriMesh;
 
 /// The cube [0.2, 0.8]³ (any frame works: the fit normalises it), outward-facing.
 fn cube() -> TriMesh {
-    let positions = (0..8)
-        .map(|i| [0.2 + 0.6 * (i & 1) as f64, 0.2 + 0.6 * ((i >> 1) & 1) as f64, 0.2 + 0.6 * ((i >> 2) & 1) as f64])
-        .collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let triangles = quads.iter().flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-    TriMesh { positions, triangles }
+    mesh_io::shapes::cuboid([0.2; 3], [0.8; 3])
 }
 
 /// Distance of `p` to the cube's surface.

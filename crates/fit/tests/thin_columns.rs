@@ -18,15 +18,7 @@ fn untrained(name: &str, k: usize) -> FitConfig {
 
 /// An axis-aligned box [0, a] × [0, b] × [0, c], outward-facing.
 fn cuboid(a: f64, b: f64, c: f64) -> TriMesh {
-    box_at([0.0; 3], [a, b, c])
-}
-
-/// An axis-aligned box from `lo` to `hi`, outward-facing.
-fn box_at(lo: [f64; 3], hi: [f64; 3]) -> TriMesh {
-    let positions = (0..8).map(|i| [0, 1, 2].map(|k| if (i >> k) & 1 == 1 { hi[k] } else { lo[k] })).collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-    let triangles = quads.iter().flat_map(|q: &[u32; 4]| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-    TriMesh { positions, triangles }
+    mesh_io::shapes::cuboid([0.0; 3], [a, b, c])
 }
 
 #[test]
@@ -57,8 +49,8 @@ fn a_thin_plate_starts_with_flat_faces() {
 #[test]
 fn a_thin_fin_keeps_its_sites_at_small_k() {
     let t = 0.016;
-    let mut mesh = box_at([0.0; 3], [1.0, 1.0, 0.3]);
-    let fin = box_at([0.1, 0.5 - t / 2.0, 0.25], [0.9, 0.5 + t / 2.0, 0.8]);
+    let mut mesh = mesh_io::shapes::cuboid([0.0; 3], [1.0, 1.0, 0.3]);
+    let fin = mesh_io::shapes::cuboid([0.1, 0.5 - t / 2.0, 0.25], [0.9, 0.5 + t / 2.0, 0.8]);
     let base = mesh.positions.len() as u32;
     mesh.positions.extend(fin.positions);
     mesh.triangles.extend(fin.triangles.iter().map(|t| t.map(|v| v + base)));

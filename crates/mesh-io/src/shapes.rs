@@ -36,6 +36,15 @@ impl Sphere {
     }
 }
 
+/// The axis-aligned box from `lo` to `hi` (each coordinate of `lo` below `hi`'s): 8 vertices,
+/// 12 triangles, genus 0.
+pub fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> TriMesh {
+    let positions = (0..8).map(|i| [0, 1, 2].map(|k| if (i >> k) & 1 == 1 { hi[k] } else { lo[k] })).collect();
+    let quads: [[u32; 4]; 6] = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let triangles = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+    TriMesh { positions, triangles }
+}
+
 /// Unit-radius icosphere centred at the origin: the icosahedron with each triangle split
 /// into four `subdivisions` times, new vertices projected onto the sphere.
 /// 20·4^s triangles (s = 5 gives 20,480), genus 0.
