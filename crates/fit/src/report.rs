@@ -295,11 +295,16 @@ impl FitReport {
         let carved = match &self.carving {
             Some(r) if inserted > 0 => format!(
                 " Then {inserted} sites were inserted in {} round(s) where the crust strayed more than {:.2}% of the \
-                 diagonal from the input (farthest crust vertex {:.3}% → {:.3}%).",
+                 diagonal from the input (farthest crust vertex {:.3}% → {:.3}%; input point farthest from the \
+                 crust {:.3}% → {:.3}%).",
                 r.inserted_per_round.len(),
                 100.0 * r.tolerance_of_diagonal,
                 100.0 * r.farthest_before / (r.tolerance / r.tolerance_of_diagonal),
-                100.0 * r.farthest_after / (r.tolerance / r.tolerance_of_diagonal)
+                100.0 * r.farthest_after / (r.tolerance / r.tolerance_of_diagonal),
+                100.0 * r.input_farthest_per_round.first().copied().unwrap_or(0.0)
+                    / (r.tolerance / r.tolerance_of_diagonal),
+                100.0 * r.input_farthest_per_round.get(r.inserted_per_round.len()).copied().unwrap_or(0.0)
+                    / (r.tolerance / r.tolerance_of_diagonal)
             ),
             _ => String::new(),
         };
