@@ -15,7 +15,7 @@
 
 use crust::{Crust, CrustConfig};
 use mesh_io::TriMesh;
-use occupancy::MeshOracle;
+use occupancy::{BvhPreset, MeshOracle};
 use serde::Serialize;
 use soft_voronoi::Solid;
 
@@ -75,26 +75,26 @@ pub fn carve(
     // spike can expose the next), so all of them run and the best state ([`best_state`]) is
     // kept: carving never makes the crust's Hausdorff distance to the input larger.
     let mut states: Vec<State> = Vec::new();
-    // The input side is certified to 0.01% of the diagonal: enough to compare states.
-    let certify = metrics::hausdorff::CertifiedOptions { rel_tolerance: 1e-4, ..Default::default() };
+    // The input side is certified to 0.01% of the diagonal: enough to compare states. The
+    // input's distance structure is built once for all rounds.
+    let certify = metrics::CertifiedOptions { rel_tolerance: 1e-4, ..Default::default() };
+    let surface_options =
+        metrics::SurfaceOptions { num_samples: F_SAMPLES, seed: 0, fscore_tau_rel: tolerance / mesh.diagonal() };
+    let input = metrics::DistanceMesh::with_preset(mesh, "input", BvhPreset::VeryFast).map_err(failure)?;
     for round in 0..=rounds {
         let crust = Crust::extract(sites, labels, &CrustConfig::default())
             .map_err(|e| FitError::Failure(format!("crust while carving: {e}")))?;
-        let fail = |e: occupancy::OccupancyError| FitError::Failure(format!("carving: {e}"));
-        let far = oracle.closest_points(&crust.mesh.positions).map_err(fail)?;
+        let far = oracle.closest_points(&crust.mesh.positions).map_err(failure)?;
         let farthest = far.iter().map(|c| c.squared_distance.sqrt()).fold(0.0, f64::max);
         let excess: f64 = far.iter().map(|c| (c.squared_distance.sqrt() - tolerance).max(0.0)).sum();
         // The other side: the input's farthest point from the crust (a dent where an
-        // inserted outside site's cell cut into the solid).
-        let missed = metrics::hausdorff::directed_hausdorff_certified(mesh, &crust.mesh, &certify)
-            .map_err(|e| FitError::Failure(format!("carving: {e}")))?
-            .hi;
-        // The rest of the surface: the F-score at the tolerance, from samples on both.
-        let surface_options =
-            metrics::SurfaceOptions { num_samples: F_SAMPLES, seed: 0, fscore_tau_rel: tolerance / mesh.diagonal() };
-        let fscore = metrics::surface_metrics(mesh, &crust.mesh, &surface_options)
-            .map_err(|e| FitError::Failure(format!("carving: {e}")))?
-            .fscore;
+        // inserted outside site's cell cut into the solid); then the rest of the surface:
+        // the F-score at the tolerance, from samples on both.
+        let crust_distance =
+            metrics::DistanceMesh::with_preset(&crust.mesh, "crust", BvhPreset::VeryFast).map_err(failure)?;
+        let missed =
+            metrics::hausdorff::directed_certify_prepared(&input, &crust_distance, &certify).map_err(failure)?.hi;
+        let fscore = metrics::surface_metrics_of(&input, &crust_distance, &surface_options).map_err(failure)?.fscore;
         states.push(State { sites: sites.len(), farthest, missed, excess, fscore });
         report.farthest_per_round.push(farthest);
         report.input_farthest_per_round.push(missed);
@@ -189,7 +189,7 @@ pub const MIN_CLEARANCE: f64 = 0.5;
 /// # Errors
 /// [`FitError::Failure`] for a non-finite site.
 pub fn clear_of_the_input(oracle: &MeshOracle, new: Vec<[f64; 3]>, tolerance: f64) -> Result<Vec<[f64; 3]>, FitError> {
-    let closest = oracle.closest_points(&new).map_err(|e| FitError::Failure(format!("carving: {e}")))?;
+    let closest = oracle.closest_points(&new).map_err(failure)?;
     let min2 = (MIN_CLEARANCE * tolerance).powi(2);
     Ok(new.into_iter().zip(&closest).filter(|(_, c)| c.squared_distance >= min2).map(|(p, _)| p).collect())
 }
@@ -221,12 +221,12 @@ struct State {
 /// diagonal but took the F-score from 0.992 to 0.962 (dents and bumps of the tolerance's
 /// size along the part's edges), which the Hausdorff distance does not see. Among those,
 /// first the two-sided farthest distance max(farthest vertex, the input's farthest point),
-/// the Hausdorff distance: inserted outside sites
-/// whose cells cut into the solid leave dents, which the crust's vertices do not show (on
-/// featuretype, cutting a spike of 1.7% of the diagonal left a dent of 1.3%). States within
-/// [`TIE`] of the least are equal on that count (where a hole or a notch the carving does not
-/// reach sets the input's side, every state has it); among them the least farthest vertex,
-/// then the least excess, then the earliest.
+/// the Hausdorff distance: inserted outside sites whose cells cut into the solid leave
+/// dents, which the crust's vertices do not show (on featuretype, cutting a spike of 1.7%
+/// of the diagonal left a dent of 1.3%). States within [`TIE`] of the least are equal on
+/// that count (where a hole or a notch the carving does not reach sets the input's side,
+/// every state has it); among them the least farthest vertex, then the least excess, then
+/// the earliest.
 fn best_state(states: &[State]) -> usize {
     let two_sided = |s: &State| s.farthest.max(s.missed);
     let admissible = |s: &State| s.fscore >= states[0].fscore - F_SLACK;
@@ -247,6 +247,11 @@ const TIE: f64 = 0.01;
 /// F-score a state may fall and still be kept.
 const F_SAMPLES: usize = 50_000;
 const F_SLACK: f64 = 0.002;
+
+/// A failed query while carving, as the fit's error.
+fn failure(e: impl std::fmt::Display) -> FitError {
+    FitError::Failure(format!("carving: {e}"))
+}
 
 /// Whether `c` (a point of triangle `t`) lies within `eps` of one of `t`'s edges that is in
 /// `open` (sorted, as [`mesh_io::topology::boundary_edges`] gives them).

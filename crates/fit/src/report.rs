@@ -293,19 +293,21 @@ impl FitReport {
         };
         let inserted: usize = self.carving.as_ref().map_or(0, |r| r.inserted_per_round.iter().sum());
         let carved = match &self.carving {
-            Some(r) if inserted > 0 => format!(
-                " Then {inserted} sites were inserted in {} round(s) where the crust strayed more than {:.2}% of the \
-                 diagonal from the input (farthest crust vertex {:.3}% → {:.3}%; input point farthest from the \
-                 crust {:.3}% → {:.3}%).",
-                r.inserted_per_round.len(),
-                100.0 * r.tolerance_of_diagonal,
-                100.0 * r.farthest_before / (r.tolerance / r.tolerance_of_diagonal),
-                100.0 * r.farthest_after / (r.tolerance / r.tolerance_of_diagonal),
-                100.0 * r.input_farthest_per_round.first().copied().unwrap_or(0.0)
-                    / (r.tolerance / r.tolerance_of_diagonal),
-                100.0 * r.input_farthest_per_round.get(r.inserted_per_round.len()).copied().unwrap_or(0.0)
-                    / (r.tolerance / r.tolerance_of_diagonal)
-            ),
+            Some(r) if inserted > 0 => {
+                let pct = |d: f64| 100.0 * d * r.tolerance_of_diagonal / r.tolerance;
+                let missed = |i: usize| pct(r.input_farthest_per_round.get(i).copied().unwrap_or(0.0));
+                format!(
+                    " Then {inserted} sites were inserted in {} round(s) where the crust strayed more than {:.2}% of \
+                     the diagonal from the input (farthest crust vertex {:.3}% → {:.3}%; input point farthest from \
+                     the crust {:.3}% → {:.3}%).",
+                    r.inserted_per_round.len(),
+                    100.0 * r.tolerance_of_diagonal,
+                    pct(r.farthest_before),
+                    pct(r.farthest_after),
+                    missed(0),
+                    missed(r.inserted_per_round.len())
+                )
+            }
             _ => String::new(),
         };
         let polished = match &self.polish {

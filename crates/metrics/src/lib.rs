@@ -39,5 +39,5 @@ pub use hausdorff::{
     hausdorff_sphere_certified_limited, CertifiedOptions, DistanceMesh, HausdorffInterval, SphereInterval,
 };
 pub use iou::{volumetric_iou, IouResult};
-pub use surface::{surface_metrics, SurfaceMetrics, SurfaceOptions};
+pub use surface::{surface_metrics, surface_metrics_of, SurfaceMetrics, SurfaceOptions};
 pub use validity::{validity, Validity};

@@ -244,3 +244,16 @@ pub fn certify_prepared(
 ) -> Result<HausdorffInterval, MetricsError> {
     certify(a, b, Sides::Both, opts)
 }
+
+/// [`directed_hausdorff_certified`] on prepared meshes (`seconds` left at 0), for callers
+/// that measure one mesh against many.
+///
+/// # Errors
+/// [`MetricsError::BadOption`].
+pub fn directed_certify_prepared(
+    a: &DistanceMesh,
+    b: &DistanceMesh,
+    opts: &CertifiedOptions,
+) -> Result<HausdorffInterval, MetricsError> {
+    certify(a, b, Sides::AToB, opts)
+}
