@@ -253,7 +253,10 @@ fn write_table(out: &Path, summaries: &[Summary], budget: &Budget, seconds: f64)
         budget.seeds,
         budget.samples,
         budget.icosphere_subdivisions,
-        budget.voronoi_steps.map_or("600 (the default)".into(), |s| s.to_string()),
+        budget.voronoi_steps.map_or_else(
+            || format!("{} (the default)", soft_voronoi::TrainConfig::default_for(8192).steps),
+            |s| s.to_string(),
+        ),
         format!(
             " on its cosine schedule, keeping its best iterate by a fixed evaluation batch's loss (measured every {} \
              steps); `flattened` when the last tenth's mean loss is not below the tenth before's by more than 1% or \
