@@ -1,7 +1,8 @@
-//! The fast winding number on any mesh files (read with mesh-io): max error against the
-//! exact one, queries above 1e-3, inside/outside flips, the share of queries the exact
-//! fallback band recomputes, work per query and time, on the query sets (half
-//! uniform in the box grown 10%, half surface samples + N(0, (1% diag)²)):
+//! The fast winding number on any mesh files (read with mesh-io): the β used
+//! (`MeshOracle::beta`), max error against the exact one, queries above 1e-3, inside/outside
+//! flips, the share of queries the exact fallback band recomputes, work per query and time,
+//! on the query sets (half uniform in the box grown 10%, half surface samples +
+//! N(0, (1% diag)²)):
 //!
 //! `cargo run --release -p occupancy --example fast_on_files -- N MESH...`
 //!
@@ -37,7 +38,7 @@ fn main() {
         let flips = w.iter().zip(&exact).filter(|(a, b)| (a.abs() >= 0.5) != (b.abs() >= 0.5)).count();
         let g = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
         let (_, fb) = g.winding_numbers_counted(&queries, WindingMode::Fast).unwrap();
-        println!("{:>14} F={:>6} maxerr {:.2e} >1e-3: {:>4} flips {:>3} | fallback {:.3}% | visited {:>6.1} exp {:>6.1} tris {:>6.1} | {:.2} us/q",
-            name, mesh.1.len(), max, over, flips, fb as f64 / n as f64 * 100.0, work[0], work[1], work[2], s / n as f64 * 1e6);
+        println!("{:>14} F={:>6} beta {:.2} maxerr {:.2e} >1e-3: {:>4} flips {:>3} | fallback {:.3}% | visited {:>6.1} exp {:>6.1} tris {:>6.1} | {:.2} us/q",
+            name, mesh.1.len(), o.beta(), max, over, flips, fb as f64 / n as f64 * 100.0, work[0], work[1], work[2], s / n as f64 * 1e6);
     }
 }
