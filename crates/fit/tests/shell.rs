@@ -143,3 +143,25 @@ fn a_mesh_without_area_is_still_refused() {
         Ok(_) => panic!("a mesh with no area has nothing to fit"),
     }
 }
+
+#[test]
+fn a_finely_meshed_rim_leaves_the_surface_its_sites() {
+    // 480 boundary edges for K = 1,024: one rim point per edge at least (the old rule) gave
+    // the rim 256 quadruplets, all of K, and the surface no triplet.
+    let out = fit::fit(&sheet(120), &small("fine rim"), &mut NoProgress).unwrap();
+    let s = &out.report.solid;
+    assert_eq!(s.rule, SolidRule::Shell);
+    let init = s.init.as_deref().unwrap();
+    let count = |what: &str| -> usize {
+        let end = init.find(what).unwrap_or_else(|| panic!("{init}"));
+        init[..end].trim_end().rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    let (triplets, rims) = (count(" triplets"), count(" rim quadruplets"));
+    // The perimeter is long for the area at this K: the spacing s solves
+    // 3·A/s² + 4·L/(s/2) = K (s = 0.072, about 111 rim points at s/2).
+    assert!(triplets >= 1024 / 6, "{init}");
+    assert!(rims > 0 && rims <= 130, "{init}");
+    let c = &out.report.crust;
+    assert!(c.is_closed && c.is_manifold && c.num_components == 1, "{c:?}");
+    assert!(out.report.quality.misclassification < 0.02, "{}", out.report.quality.misclassification);
+}

@@ -382,7 +382,7 @@ pub fn poisson_subset(points: &[[f64; 3]], target: usize) -> (Vec<u32>, f64) {
 
 /// Points of `points`, in order, kept when no kept point lies within `r` (a uniform grid
 /// of cells of side ≥ r over the unit cube, 27 neighbouring cells checked).
-fn greedy_disk(points: &[[f64; 3]], r: f64) -> Vec<u32> {
+pub fn greedy_disk(points: &[[f64; 3]], r: f64) -> Vec<u32> {
     greedy_disk_around(&[], points, r)
 }
 
