@@ -338,6 +338,15 @@ impl FitReport {
             ),
             _ => String::new(),
         };
+        let interior = if self.solid.cap_samples > 0 {
+            format!(
+                "{interior} The solid closes the input's holes by the |winding number| = 0.5 surface; {} points of \
+                 it away from the input were added to the surface samples (caps), so sites stand there too.",
+                self.solid.cap_samples
+            )
+        } else {
+            interior
+        };
         let pruned = match &self.pruning {
             Some(p) if p.sites_after < p.sites_before => format!(
                 " Last, {} sites whose Delaunay neighbours all carry their label were removed (they change neither \

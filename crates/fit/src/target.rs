@@ -71,6 +71,11 @@ pub struct SolidReport {
     /// faces of the diagram where the crust has none): the initialisation, the surface
     /// term and the polish use the rest. 0 when the share is below 5%.
     pub interior_surface_samples_dropped: usize,
+    /// Points of the winding solid's boundary away from the input (caps across the holes
+    /// of an open mesh: the |w| = 0.5 level set, found from the uniform pool, see
+    /// [`cap_samples`]) added to the surface samples, so that the initialisation puts site
+    /// pairs and the polish pulls bisectors there too (winding solid of an open mesh only).
+    pub cap_samples: usize,
 }
 
 /// Surface samples probed first to decide whether the pool has interior surface at all.
@@ -127,6 +132,125 @@ fn drop_interior_surface(solid: &dyn Solid, data: &mut TrainingData, diagonal: f
     (share, dropped)
 }
 
+/// Points where the winding solid's boundary leaves the input: across the holes of an
+/// open mesh the solid is closed by the |w| = 0.5 level set, a smooth cap with no input
+/// surface and so no surface samples, pairs or polish targets; its crust came out as fans
+/// of long Voronoi faces between the sites at the hole's rim (libigl's halftunnel and
+/// camelhead). Uniform pool points with ||w| − 0.5| < [`CAP_BAND`] farther than
+/// [`CAP_CLEARANCE`] pair spacings from the input are moved onto the level set by one
+/// Newton step along the gradient of |w| (central differences at a quarter spacing) and
+/// kept when |w| is then within [`CAP_LEVEL`] of 0.5 and still that far from the input,
+/// with the gradient's direction as their normal. Returns (points, normals), unit frame.
+///
+/// # Errors
+/// [`FitError::Failure`] when an oracle query fails.
+pub fn cap_samples(
+    oracle: &MeshOracle,
+    uniform: &[[f64; 3]],
+    spacing: f64,
+) -> Result<CapSamples, FitError> {
+    let fail = |e: occupancy::OccupancyError| FitError::Failure(format!("cap samples: {e}"));
+    let fast = occupancy::WindingMode::Fast;
+    let w = oracle.winding_numbers(uniform, fast).map_err(fail)?;
+    let band: Vec<[f64; 3]> =
+        uniform.iter().zip(&w).filter(|(_, w)| (w.abs() - 0.5).abs() < CAP_BAND).map(|(p, _)| *p).collect();
+    if band.is_empty() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let clearance2 = (CAP_CLEARANCE * spacing).powi(2);
+    let far = |points: &[[f64; 3]]| -> Result<Vec<bool>, FitError> {
+        Ok(oracle.closest_points(points).map_err(fail)?.iter().map(|c| c.squared_distance > clearance2).collect())
+    };
+    let band: Vec<[f64; 3]> = band.iter().zip(far(&band)?).filter(|(_, f)| *f).map(|(p, _)| *p).collect();
+    // |w| and its gradient at each point (w keeps its sign this near the level set).
+    let e = 0.25 * spacing;
+    let mut probes = Vec::with_capacity(7 * band.len());
+    for p in &band {
+        probes.push(*p);
+        for axis in 0..3 {
+            for sign in [1.0, -1.0] {
+                let mut q = *p;
+                q[axis] += sign * e;
+                probes.push(q);
+            }
+        }
+    }
+    let v = oracle.winding_numbers(&probes, fast).map_err(fail)?;
+    let mut moved = Vec::new();
+    let mut normals = Vec::new();
+    for (p, v) in band.iter().zip(v.chunks_exact(7)) {
+        let s = v[0].signum();
+        let g = [0, 1, 2].map(|a| s * (v[1 + 2 * a] - v[2 + 2 * a]) / (2.0 * e));
+        let g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if !(g2 > 0.0 && g2.is_finite()) {
+            continue;
+        }
+        let t = (s * v[0] - 0.5) / g2;
+        let step = [0, 1, 2].map(|a| -t * g[a]);
+        if step.iter().map(|x| x * x).sum::<f64>() > (2.0 * e).powi(2) {
+            continue;
+        }
+        let q = [0, 1, 2].map(|a| (p[a] + step[a]).clamp(0.0, 1.0));
+        let gl = g2.sqrt();
+        moved.push(q);
+        normals.push(g.map(|x| x / gl));
+    }
+    if moved.is_empty() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let w = oracle.winding_numbers(&moved, fast).map_err(fail)?;
+    let keep: Vec<bool> = far(&moved)?.iter().zip(&w).map(|(&f, w)| f && (w.abs() - 0.5).abs() < CAP_LEVEL).collect();
+    let pick = |v: &[[f64; 3]]| v.iter().zip(&keep).filter(|(_, &k)| k).map(|(p, _)| *p).collect::<Vec<_>>();
+    Ok((pick(&moved), pick(&normals)))
+}
+
+/// Points on a cap and their unit normals ([`cap_samples`]).
+pub type CapSamples = (Vec<[f64; 3]>, Vec<[f64; 3]>);
+
+/// Half-width of the band of |w| around 0.5 from which [`cap_samples`] starts.
+const CAP_BAND: f64 = 0.15;
+
+/// How close to 0.5 a cap sample's |w| must be after its Newton step.
+const CAP_LEVEL: f64 = 0.02;
+
+/// Least distance of a cap sample from the input, in pair spacings √(2A/K): nearer, the
+/// input's own pairs shape the crust.
+const CAP_CLEARANCE: f64 = 1.5;
+
+/// [`cap_samples`] for the uniform part of `data`'s pool (its first `num_uniform` points),
+/// spread at about the pair spacing and put at seeded places among the first 12·K surface
+/// samples (the initialisation's candidates) with the samples they displace moved to the
+/// end, so the initialisation and the polish see them. Returns how many were added.
+fn add_cap_samples(
+    oracle: &MeshOracle,
+    data: &mut TrainingData,
+    num_uniform: usize,
+    area: f64,
+    k: usize,
+    seed: u64,
+) -> Result<usize, FitError> {
+    let n = data.surface.len();
+    if n == 0 || data.normals.len() != n || k < 2 {
+        return Ok(0);
+    }
+    let spacing = (2.0 * area / k as f64).sqrt();
+    let (points, normals) = cap_samples(oracle, &data.points[..num_uniform.min(data.points.len())], spacing)?;
+    // As dense as the surface samples at most (one per A/n of area), so that each counts
+    // like one of them in the polish and the candidates.
+    let keep = greedy_disk(&points, (area / n as f64).sqrt());
+    let m = n.min(12 * k);
+    let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 6);
+    for &i in &keep {
+        let j = (rng.next_u64() % m as u64) as usize;
+        let (p, nrm) = (data.surface[j], data.normals[j]);
+        data.surface.push(p);
+        data.normals.push(nrm);
+        data.surface[j] = points[i as usize];
+        data.normals[j] = normals[i as usize];
+    }
+    Ok(keep.len())
+}
+
 /// Chooses the solid for `data` (labelled by `winding`, near-surface samples from
 /// `num_uniform` on; `is_closed`: the mesh's topology) and, for the shell, relabels the pool and moves its surface points onto
 /// the shell's two sides (alternately). `scale`: input units per unit-cube length.
@@ -169,6 +293,11 @@ pub(crate) fn choose<'a>(
         }
         let solid = MeshSolid { oracle };
         let (interior, dropped) = drop_interior_surface(&solid, data, diagonal);
+        let caps = if is_closed {
+            0
+        } else {
+            add_cap_samples(oracle, data, num_uniform, sampler.total_area(), config.train.num_sites, config.train.seed)?
+        };
         let report = SolidReport {
             rule: SolidRule::Winding,
             chosen_by,
@@ -179,6 +308,7 @@ pub(crate) fn choose<'a>(
             init: None,
             interior_surface_share: Some(interior),
             interior_surface_samples_dropped: dropped,
+            cap_samples: caps,
         };
         return Ok((Target::Winding(solid), report));
     }
@@ -219,6 +349,7 @@ pub(crate) fn choose<'a>(
         )),
         interior_surface_share: None,
         interior_surface_samples_dropped: 0,
+        cap_samples: 0,
     };
     Ok((Target::Shell(solid, sites, labels), report))
 }
