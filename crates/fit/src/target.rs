@@ -144,11 +144,7 @@ fn drop_interior_surface(solid: &dyn Solid, data: &mut TrainingData, diagonal: f
 ///
 /// # Errors
 /// [`FitError::Failure`] when an oracle query fails.
-pub fn cap_samples(
-    oracle: &MeshOracle,
-    uniform: &[[f64; 3]],
-    spacing: f64,
-) -> Result<CapSamples, FitError> {
+pub fn cap_samples(oracle: &MeshOracle, uniform: &[[f64; 3]], spacing: f64) -> Result<CapSamples, FitError> {
     let fail = |e: occupancy::OccupancyError| FitError::Failure(format!("cap samples: {e}"));
     let fast = occupancy::WindingMode::Fast;
     let w = oracle.winding_numbers(uniform, fast).map_err(fail)?;
@@ -218,9 +214,10 @@ const CAP_LEVEL: f64 = 0.02;
 const CAP_CLEARANCE: f64 = 1.5;
 
 /// [`cap_samples`] for the uniform part of `data`'s pool (its first `num_uniform` points),
-/// spread at about the pair spacing and put at seeded places among the first 12·K surface
-/// samples (the initialisation's candidates) with the samples they displace moved to the
-/// end, so the initialisation and the polish see them. Returns how many were added.
+/// thinned to at most the surface samples' density and put at seeded places among the
+/// first 12·K surface samples (the initialisation's candidates), with the samples they
+/// displace moved to the end, so the initialisation and the polish see them. Returns how
+/// many were added.
 fn add_cap_samples(
     oracle: &MeshOracle,
     data: &mut TrainingData,
@@ -382,12 +379,11 @@ fn shell_sites(
     let s = 1.0 / u.max(1e-300);
     // Rim points spaced [`RIM_SPACING`]·s along the boundary: candidates every s/4 along each
     // boundary edge (at least one per edge), then those with no other that near, greedily in
-    // edge order
-    // (a subset truncated to a count would drop a stretch of rim at the end of the list and
-    // leave the band open there). One point per edge at least, as before, gave a finely
-    // meshed rim far more points than L/s: on libigl's beetle body the rims took 4,544 of
-    // the 8,192 sites and left 1,216 triplets for the whole surface, on its truck 7,320 and
-    // 290.
+    // edge order (a subset truncated to a count would drop a stretch of rim at the end of
+    // the list and leave the band open there). One point per edge at least, as before, gave
+    // a finely meshed rim far more points than L/s: on libigl's beetle body the rims took
+    // 4,544 of the 8,192 sites and left 1,216 triplets for the whole surface, on its truck
+    // 7,320 and 290.
     // The rim's corners come first, so the greedy pass keeps them: without a point there the
     // band stays open around the corner (the benchmark's sheet grew a spike of 4.6% of the
     // diagonal past a corner at K = 2,048).
@@ -403,11 +399,13 @@ fn shell_sites(
     let points: Vec<[f64; 3]> = candidates.iter().map(|c| c.0).collect();
     let mut r = RIM_SPACING * s;
     let mut picked = greedy_disk(&points, r);
-    while picked.len() > k / 4 {
-        // More rim than a quarter of the budget: spread the rim points wider.
+    while picked.len() > k / 4 && r < 2.0 {
+        // More rim than a quarter of the budget: spread the rim points wider (at r ≥ √3 one
+        // point is left in the unit cube).
         r *= 1.25;
         picked = greedy_disk(&points, r);
     }
+    picked.truncate(k / 4);
     let rim_points: Vec<RimPoint> = picked.iter().map(|&i| candidates[i as usize]).collect();
     let triplets = (k - 4 * rim_points.len()) / 3;
     let (chosen, _) = poisson_subset(surface, triplets.min(surface.len()));

@@ -165,3 +165,21 @@ fn a_finely_meshed_rim_leaves_the_surface_its_sites() {
     assert!(c.is_closed && c.is_manifold && c.num_components == 1, "{c:?}");
     assert!(out.report.quality.misclassification < 0.02, "{}", out.report.quality.misclassification);
 }
+
+#[test]
+fn a_shell_with_fewer_sites_than_a_rim_quadruplet_still_fits() {
+    // K < 4 leaves no room for a rim point: spreading the rim points wider must stop (it
+    // looped forever at K = 3 before the bound), and K = 5 or 7 have room for one.
+    for (k, rims) in [(3, 0), (5, 1), (7, 1)] {
+        let mut c = small("tiny");
+        c.train.num_sites = k;
+        let out = fit::fit(&sheet(8), &c, &mut NoProgress).unwrap();
+        assert_eq!(out.report.solid.rule, SolidRule::Shell);
+        let init = out.report.solid.init.unwrap();
+        assert!(init.contains(&format!("and {rims} rim quadruplets")), "K = {k}: {init}");
+    }
+    // K = 2 has room for nothing but two filler sites: an error (an empty crust), no hang.
+    let mut c = small("tiny");
+    c.train.num_sites = 2;
+    let _ = fit::fit(&sheet(8), &c, &mut NoProgress);
+}
