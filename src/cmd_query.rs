@@ -83,12 +83,13 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.timings {
         let json = |x: Option<f64>| x.map_or("null".to_string(), |v| format!("{v:.3}"));
         eprintln!(
-            "{{\"num_queries\": {}, \"num_triangles\": {}, \"threads\": {}, \"build_s\": {build_s:.6}, \"winding_s\": {winding_s:.6}, \"distance_s\": {distance_s:.6}, \"winding_cpu_s\": {}, \"distance_cpu_s\": {}, \"exact_fallbacks\": {fallbacks}}}",
+            "{{\"num_queries\": {}, \"num_triangles\": {}, \"threads\": {}, \"build_s\": {build_s:.6}, \"winding_s\": {winding_s:.6}, \"distance_s\": {distance_s:.6}, \"winding_cpu_s\": {}, \"distance_cpu_s\": {}, \"exact_fallbacks\": {fallbacks}, \"simd\": \"{}\"}}",
             queries.len(),
             oracle.num_triangles(),
             available_threads(),
             json(winding_cpu_s),
             json(distance_cpu_s),
+            occupancy::winding::fast::simd_path(),
         );
     }
     Ok(())

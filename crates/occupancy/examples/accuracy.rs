@@ -44,9 +44,9 @@ fn main() {
         let t_exact = t.elapsed().as_secs_f64();
         let cpu_exact = cpu_seconds() - c0;
         for &beta in &betas {
-            let leaf: u32 = std::env::var("LEAF").ok().map(|s| s.parse().unwrap()).unwrap_or(8);
-            let raw_config = Config { beta, max_leaf_size: leaf, exact_fallback_margin: 0.0, ..Config::default() };
-            let guarded_config = Config { beta, max_leaf_size: leaf, ..Config::default() };
+            let leaf: u32 = std::env::var("LEAF").ok().map(|s| s.parse().unwrap()).unwrap_or(2);
+            let raw_config = Config { beta, winding_leaf_size: leaf, exact_fallback_margin: 0.0, ..Config::default() };
+            let guarded_config = Config { beta, winding_leaf_size: leaf, ..Config::default() };
             let raw = MeshOracle::new(&mesh.0, &mesh.1, &raw_config).unwrap();
             let guarded = MeshOracle::new(&mesh.0, &mesh.1, &guarded_config).unwrap();
             let t = Instant::now();

@@ -1,5 +1,6 @@
 //! Runs one query kind on one mesh, single-threaded friendly, for profilers:
-//! `cargo run --release -p occupancy --example profile -- fast|exact|distance MESH_FILE N [BETA]`
+//! `cargo run --release -p occupancy --example profile -- fast|exact|distance MESH_FILE N [BETA]
+//! [WINDING_LEAF_SIZE] [veryfast|fast|medium] [MAX_LEAF_SIZE]`
 //! (MESH_FILE `icosphere` builds the 20,480-face icosphere). Prints CPU-independent work
 //! counts and the wall time.
 
@@ -20,6 +21,9 @@ fn main() {
         config.beta = b.parse().unwrap();
     }
     if let Some(l) = args.get(5) {
+        config.winding_leaf_size = l.parse().unwrap();
+    }
+    if let Some(l) = args.get(7) {
         config.max_leaf_size = l.parse().unwrap();
     }
     if let Some(p) = args.get(6) {

@@ -131,7 +131,12 @@ impl MeshOracle {
             }
             corners.push([positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]]);
         }
-        let bvh = build_triangle_bvh(&corners, config.bvh_preset, config.max_leaf_size);
+        let bvh = build_triangle_bvh(
+            &corners,
+            config.bvh_preset,
+            config.winding_leaf_size.min(config.max_leaf_size),
+            config.max_leaf_size,
+        );
         debug_assert_eq!(bvh.validate(), Ok(()));
         let beta = effective_beta(config.beta, &corners);
         let fast = build_fast_nodes(&bvh, beta);

@@ -48,3 +48,30 @@ fn signed_distance_of_sphere_is_radius_offset() {
         assert_eq!(batch.sdf[i] < 0.0 || batch.sdf[i] == 0.0 && batch.occupancy[i] == 1, batch.occupancy[i] == 1);
     }
 }
+
+/// The tree is built with the smaller of the two leaf sizes and the box traversals stop at
+/// subtrees of `max_leaf_size` triangles; whatever the pair, closest points stay exact,
+/// the exact winding number stays the brute-force one, the inside rule does not change and
+/// the fast winding number stays within 1e-3 of it.
+#[test]
+fn every_leaf_size_pair_gives_the_same_answers() {
+    let mesh = common::icosphere(3);
+    let reference = MeshOracle::new(&mesh.0, &mesh.1, &Config::default()).unwrap();
+    let queries = common::issue_queries(&mesh, 1500, 3);
+    let want_points = reference.closest_points(&queries).unwrap();
+    let want_exact = reference.winding_numbers(&queries, WindingMode::Exact).unwrap();
+    for (winding_leaf_size, max_leaf_size) in [(1, 1), (1, 8), (2, 8), (8, 8), (8, 2), (4, 30), (30, 30)] {
+        let config = Config { winding_leaf_size, max_leaf_size, ..Config::default() };
+        let oracle = MeshOracle::new(&mesh.0, &mesh.1, &config).unwrap();
+        assert_eq!(oracle.bvh().validate(), Ok(()));
+        let points = oracle.closest_points(&queries).unwrap();
+        let exact = oracle.winding_numbers(&queries, WindingMode::Exact).unwrap();
+        let fast = oracle.winding_numbers(&queries, WindingMode::Fast).unwrap();
+        for i in 0..queries.len() {
+            let tag = format!("leaves ({winding_leaf_size}, {max_leaf_size}) at {:?}", queries[i]);
+            assert_eq!(points[i].squared_distance, want_points[i].squared_distance, "{tag}");
+            assert!((exact[i] - want_exact[i]).abs() < 1e-12, "{tag}: {} vs {}", exact[i], want_exact[i]);
+            assert!((fast[i] - want_exact[i]).abs() < 1e-3, "{tag}: fast {} vs {}", fast[i], want_exact[i]);
+        }
+    }
+}

@@ -26,6 +26,8 @@ fn mesh_errors() {
         Config { beta: f64::NAN, ..Config::default() },
         Config { exact_fallback_margin: -1.0, ..Config::default() },
         Config { max_leaf_size: 0, ..Config::default() },
+        Config { winding_leaf_size: 0, ..Config::default() },
+        Config { winding_leaf_size: 256, ..Config::default() },
     ] {
         assert!(matches!(MeshOracle::new(&p, &t, &config), Err(OccupancyError::BadConfig(_))));
     }

@@ -33,14 +33,24 @@ fn f32_up(x: f64) -> f32 {
 ///
 /// - `corners`: #F triangles, each three f64 corners in the mesh frame (input order).
 /// - `preset`: obvhs build preset (never with spatial splits).
-/// - `max_leaf_size`: most triangles per leaf (1..=255).
+/// - `build_leaf_size`: most triangles per obvhs leaf (1..=255): the tree the winding
+///   numbers walk.
+/// - `box_leaf_size`: the box traversals (closest points, crossing counts) stop at the
+///   first node with at most this many triangles (its slot range is contiguous) and test
+///   them all, so they walk a tree with leaves of this size (≥ `build_leaf_size` to
+///   have an effect).
 ///
 /// # Complexity
 /// O(F log F) for the obvhs build plus O(F) for the f64 arrays.
 ///
 /// # Panics
 /// If `corners` is empty (the oracle checks this first).
-pub fn build_triangle_bvh(corners: &[[V3; 3]], preset: BvhPreset, max_leaf_size: u32) -> TriangleBvh {
+pub fn build_triangle_bvh(
+    corners: &[[V3; 3]],
+    preset: BvhPreset,
+    build_leaf_size: u32,
+    box_leaf_size: u32,
+) -> TriangleBvh {
     assert!(!corners.is_empty(), "BVH needs at least one triangle");
     let aabbs: Vec<Aabb> = corners
         .iter()
@@ -63,7 +73,7 @@ pub fn build_triangle_bvh(corners: &[[V3; 3]], preset: BvhPreset, max_leaf_size:
     };
     // Spatial splits would put a triangle in two leaves and double its winding number.
     params.pre_split = false;
-    params.max_prims_per_leaf = max_leaf_size.clamp(1, 255);
+    params.max_prims_per_leaf = build_leaf_size.clamp(1, 255);
     let mut build_time = Duration::ZERO;
     let bvh = build_bvh2(&aabbs, params, &mut build_time);
 
@@ -120,7 +130,11 @@ pub fn build_triangle_bvh(corners: &[[V3; 3]], preset: BvhPreset, max_leaf_size:
         .map(|n| HotBox {
             lo: box_lo[n],
             hi: box_hi[n],
-            link: if bvh.nodes[n].prim_count > 0 { range[n] } else { [bvh.nodes[n].first_index, u32::MAX] },
+            link: if bvh.nodes[n].prim_count > 0 || range[n][1] - range[n][0] <= box_leaf_size {
+                range[n]
+            } else {
+                [bvh.nodes[n].first_index, u32::MAX]
+            },
         })
         .collect();
     let planes = slot_corners

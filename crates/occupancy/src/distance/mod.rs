@@ -131,7 +131,7 @@ impl TriangleBvh {
             }
             corners.push([positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]]);
         }
-        Ok(crate::bvh::build_triangle_bvh(&corners, config.bvh_preset, config.max_leaf_size))
+        Ok(crate::bvh::build_triangle_bvh(&corners, config.bvh_preset, config.max_leaf_size, config.max_leaf_size))
     }
 
     /// Closest point on the triangles to `q`: the same branch-and-bound and the same

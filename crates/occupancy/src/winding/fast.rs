@@ -306,16 +306,23 @@ pub(crate) fn fast_solid_angle_sum(bvh: &TriangleBvh, nodes: &FastNodes, q: V3, 
     sum
 }
 
-/// Queries per packet of [`fast_solid_angle_sums`]. Measured single-threaded on the
-/// bunny and a 20,480-face icosphere (200k issue queries): 8 lanes 3.5 µs/query, 16 lanes
-/// 2.9, 32 lanes 3.5–4.2 (the packets' union of visited nodes grows).
+/// Queries per packet of [`fast_solid_angle_sums`] with AVX2 or plain SSE2. Measured
+/// single-threaded on the bunny and a 20,480-face icosphere (200k issue queries): 8 lanes
+/// 3.5 µs/query, 16 lanes 2.9, 32 lanes 3.5–4.2 (the packets' union of visited nodes grows
+/// faster than the 4-wide vectors gain).
 pub(crate) const LANES: usize = 16;
 
-/// One bit per lane of a packet.
-pub(crate) type LaneMask = u16;
+/// Queries per packet with AVX-512 (8 f64 per vector). One thread, 400k issue queries,
+/// 8-triangle leaves: 16 lanes 1.41 µs/query on the icosphere, 32 lanes 1.30, 64 lanes 1.69
+/// (AVX2 at 16 lanes: 1.62).
+pub(crate) const LANES_AVX512: usize = 32;
 
-/// [`fast_solid_angle_sum`] for many queries, traversed in packets of [`LANES`]
-/// consecutive queries (callers pass them in a spatially coherent order, e.g. Morton).
+/// One bit per lane of a packet (at most 32 lanes).
+pub(crate) type LaneMask = u32;
+
+/// [`fast_solid_angle_sum`] for many queries, traversed in packets of [`LANES`] (or
+/// [`LANES_AVX512`]) consecutive queries (callers pass them in a spatially coherent
+/// order, e.g. Morton).
 ///
 /// A packet walks the tree once with a lane mask: at each node the acceptance test runs
 /// for all lanes at once, the expansion is evaluated for every lane that accepts it (all
@@ -324,7 +331,8 @@ pub(crate) type LaneMask = u16;
 /// node's 40-byte record and 192-byte moments are loaded once per packet instead of once
 /// per query, and the acceptance branch becomes a mask test. Every lane adds exactly the
 /// terms [`fast_solid_angle_sum`] adds for its query, in the same order and with the same
-/// arithmetic, so the results are bit-identical to the one-query traversal (tested).
+/// arithmetic, so the results are bit-identical to the one-query traversal whatever the
+/// packet width or instruction set (tested).
 ///
 /// - `qs`: #Q query points, mesh frame.
 /// - `out`: #Q results (4π times the winding number).
@@ -339,26 +347,104 @@ pub(crate) fn fast_solid_angle_sums(
     debug_assert_eq!(qs.len(), out.len());
     #[cfg(target_arch = "x86_64")]
     {
-        if avx2_available() {
-            for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
-                // SAFETY: the CPU supports AVX2 (checked at run time). AVX2 changes only
-                // the vector width: IEEE operations round lane by lane exactly as with
-                // SSE2, and no fused multiply-add is enabled, so the bits are the same.
-                unsafe { packet_avx2(bvh, nodes, q, o, stack) };
+        match simd_level() {
+            Simd::Avx512 => {
+                for (q, o) in qs.chunks(LANES_AVX512).zip(out.chunks_mut(LANES_AVX512)) {
+                    // SAFETY: the CPU supports AVX-512F/VL/DQ (checked at run time). As
+                    // with AVX2 below, only the vector width changes.
+                    unsafe { packet_avx512(bvh, nodes, q, o, stack) };
+                }
+                return;
             }
-            return;
+            Simd::Avx2 => {
+                for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+                    // SAFETY: the CPU supports AVX2 (checked at run time). AVX2 changes
+                    // only the vector width: IEEE operations round lane by lane exactly
+                    // as with SSE2, and no fused multiply-add is enabled (Rust never
+                    // contracts a * b + c), so the bits are the same.
+                    unsafe { packet_avx2(bvh, nodes, q, o, stack) };
+                }
+                return;
+            }
+            Simd::Sse2 => {}
         }
     }
     for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
-        packet(bvh, nodes, q, o, stack);
+        packet::<LANES>(bvh, nodes, q, o, stack);
+    }
+}
+
+/// The widest vector instructions the packet traversal may use on this CPU.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Simd {
+    Avx512,
+    Avx2,
+    Sse2,
+}
+
+/// Detected once per process. `VORONOI_FIT_SIMD=avx2` or `=sse2` caps it (for
+/// benchmarking the narrower paths and for tests that compare them).
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn simd_level() -> Simd {
+    use std::sync::OnceLock;
+    static LEVEL: OnceLock<Simd> = OnceLock::new();
+    *LEVEL.get_or_init(|| {
+        let cap = std::env::var("VORONOI_FIT_SIMD").unwrap_or_default();
+        let avx512 = simd_supported(Simd::Avx512);
+        let avx2 = simd_supported(Simd::Avx2);
+        match cap.as_str() {
+            "sse2" => Simd::Sse2,
+            "avx2" if avx2 => Simd::Avx2,
+            _ if avx512 && cap.is_empty() => Simd::Avx512,
+            _ if avx2 => Simd::Avx2,
+            _ => Simd::Sse2,
+        }
+    })
+}
+
+/// Name of the packet path the fast winding number uses in this process (`"avx512"`,
+/// `"avx2"` or `"sse2"`), for timing reports.
+pub fn simd_path() -> &'static str {
+    #[cfg(target_arch = "x86_64")]
+    {
+        match simd_level() {
+            Simd::Avx512 => "avx512",
+            Simd::Avx2 => "avx2",
+            Simd::Sse2 => "sse2",
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        "portable"
+    }
+}
+
+/// Whether this CPU has the features `level`'s packet function is compiled for.
+#[cfg(target_arch = "x86_64")]
+fn simd_supported(level: Simd) -> bool {
+    match level {
+        Simd::Avx512 => {
+            std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512vl")
+                && std::arch::is_x86_feature_detected!("avx512dq")
+                && std::arch::is_x86_feature_detected!("avx2")
+        }
+        Simd::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+        Simd::Sse2 => true,
     }
 }
 
 #[cfg(target_arch = "x86_64")]
-fn avx2_available() -> bool {
-    use std::sync::OnceLock;
-    static AVX2: OnceLock<bool> = OnceLock::new();
-    *AVX2.get_or_init(|| std::arch::is_x86_feature_detected!("avx2"))
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx2")]
+unsafe fn packet_avx512(
+    bvh: &TriangleBvh,
+    nodes: &FastNodes,
+    qs: &[V3],
+    out: &mut [f64],
+    stack: &mut Vec<(u32, LaneMask)>,
+) {
+    packet::<LANES_AVX512>(bvh, nodes, qs, out, stack)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -370,41 +456,47 @@ unsafe fn packet_avx2(
     out: &mut [f64],
     stack: &mut Vec<(u32, LaneMask)>,
 ) {
-    packet(bvh, nodes, qs, out, stack)
+    packet::<LANES>(bvh, nodes, qs, out, stack)
 }
 
-/// One packet of at most [`LANES`] queries (see [`fast_solid_angle_sums`]).
+/// One packet of at most `L` (≤ 32) queries (see [`fast_solid_angle_sums`]).
 #[inline(always)]
-fn packet(bvh: &TriangleBvh, nodes: &FastNodes, qs: &[V3], out: &mut [f64], stack: &mut Vec<(u32, LaneMask)>) {
+fn packet<const L: usize>(
+    bvh: &TriangleBvh,
+    nodes: &FastNodes,
+    qs: &[V3],
+    out: &mut [f64],
+    stack: &mut Vec<(u32, LaneMask)>,
+) {
     let hot = &nodes.hot[..];
     let moments = &nodes.moments[..];
     let corners = &bvh.corners[..];
-    let n = qs.len().min(LANES);
+    let n = qs.len().min(L);
     if n == 0 {
         return;
     }
     // Unused lanes repeat the first query and are masked off.
-    let mut qx = [qs[0][0]; LANES];
-    let mut qy = [qs[0][1]; LANES];
-    let mut qz = [qs[0][2]; LANES];
+    let mut qx = [qs[0][0]; L];
+    let mut qy = [qs[0][1]; L];
+    let mut qz = [qs[0][2]; L];
     for (i, q) in qs.iter().enumerate().take(n) {
         qx[i] = q[0];
         qy[i] = q[1];
         qz[i] = q[2];
     }
-    let all: LaneMask = if n == LANES { LaneMask::MAX } else { (1 << n) - 1 };
-    let mut sum = [0.0f64; LANES];
+    let all: LaneMask = if n == 32 { LaneMask::MAX } else { (1 << n) - 1 };
+    let mut sum = [0.0f64; L];
     stack.clear();
     stack.push((0, all));
     while let Some((node, mask)) = stack.pop() {
         let h = &hot[node as usize];
         let cf = h.center_far;
-        let mut rx = [0.0; LANES];
-        let mut ry = [0.0; LANES];
-        let mut rz = [0.0; LANES];
-        let mut rho2 = [0.0; LANES];
+        let mut rx = [0.0; L];
+        let mut ry = [0.0; L];
+        let mut rz = [0.0; L];
+        let mut rho2 = [0.0; L];
         let mut far: LaneMask = 0;
-        for i in 0..LANES {
+        for i in 0..L {
             rx[i] = cf[0] - qx[i];
             ry[i] = cf[1] - qy[i];
             rz[i] = cf[2] - qz[i];
@@ -417,7 +509,7 @@ fn packet(bvh: &TriangleBvh, nodes: &FastNodes, qs: &[V3], out: &mut [f64], stac
             if far.count_ones() >= 3 {
                 // All lanes in one loop; lanes that did not accept add nothing (their
                 // value may be inf or NaN at ρ = 0, so it is selected away, not scaled).
-                for i in 0..LANES {
+                for i in 0..L {
                     let v = m.eval([rx[i], ry[i], rz[i]], rho2[i]);
                     sum[i] += if far >> i & 1 == 1 { v } else { 0.0 };
                 }
@@ -439,7 +531,7 @@ fn packet(bvh: &TriangleBvh, nodes: &FastNodes, qs: &[V3], out: &mut [f64], stac
             if near.count_ones() >= 3 {
                 for t in tris {
                     let w = solid_angle_lanes(&qx, &qy, &qz, t[0], t[1], t[2]);
-                    for i in 0..LANES {
+                    for i in 0..L {
                         sum[i] += if near >> i & 1 == 1 { w[i] } else { 0.0 };
                     }
                 }
@@ -507,6 +599,58 @@ mod tests {
             }
         }
         tris
+    }
+
+    /// Every packet width and instruction set the dispatcher may pick (16 lanes in plain
+    /// code and with AVX2, 32 lanes with AVX-512, each run when the CPU has it) gives the
+    /// one-query traversal's bits, including partial packets and queries on vertices.
+    #[test]
+    fn every_packet_path_equals_one_query_at_a_time_bit_for_bit() {
+        let tris = patch();
+        let bvh = crate::bvh::build_triangle_bvh(&tris, crate::config::BvhPreset::Medium, 2, 8);
+        let nodes = build_fast_nodes(&bvh, 2.5);
+        let mut state = 7u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 1.6 - 0.8
+        };
+        let mut qs: Vec<V3> = (0..1_037).map(|_| [next(), next(), 0.3 * next()]).collect();
+        qs.extend(tris.iter().step_by(5).map(|t| t[1]));
+        let mut stack = Vec::new();
+        let one: Vec<f64> = qs.iter().map(|q| fast_solid_angle_sum(&bvh, &nodes, *q, &mut stack)).collect();
+        let check = |name: &str, got: &[f64]| {
+            for (i, (a, b)) in one.iter().zip(got).enumerate() {
+                assert!(a.to_bits() == b.to_bits() || (*a == 0.0 && *b == 0.0), "{name}, query {i}: {a:e} vs {b:e}");
+            }
+        };
+        let mut packets = Vec::new();
+        let mut out = vec![0.0; qs.len()];
+        for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            packet::<LANES>(&bvh, &nodes, q, o, &mut packets);
+        }
+        check("plain", &out);
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                let mut out = vec![0.0; qs.len()];
+                for (q, o) in qs.chunks(LANES).zip(out.chunks_mut(LANES)) {
+                    // SAFETY: AVX2 checked above.
+                    unsafe { packet_avx2(&bvh, &nodes, q, o, &mut packets) };
+                }
+                check("avx2", &out);
+            }
+            if simd_supported(Simd::Avx512) {
+                let mut out = vec![0.0; qs.len()];
+                for (q, o) in qs.chunks(LANES_AVX512).zip(out.chunks_mut(LANES_AVX512)) {
+                    // SAFETY: AVX-512F/VL/DQ checked above.
+                    unsafe { packet_avx512(&bvh, &nodes, q, o, &mut packets) };
+                }
+                check("avx512", &out);
+            }
+        }
+        let mut out = vec![0.0; qs.len()];
+        fast_solid_angle_sums(&bvh, &nodes, &qs, &mut out, &mut packets);
+        check("dispatched", &out);
     }
 
     #[test]
