@@ -6,6 +6,8 @@
 //!
 //! `cargo run --release -p occupancy --example fast_on_files -- N MESH...`
 //!
+//! `VF_BETA=B` sets `Config::beta` (default 3.5; the mesh's β is then B·max(1, A/A_box)^¼).
+//!
 //! Exact values are cached in /tmp (`exact_STEM_#V_#F_N.bin`) between runs.
 use occupancy::{Config, MeshOracle, WindingMode};
 #[path = "../tests/common/mod.rs"]
@@ -25,7 +27,8 @@ fn main() {
             std::fs::write(&cache, e.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()).unwrap();
             e
         };
-        let cfg = Config { exact_fallback_margin: 0.0, ..Config::default() };
+        let beta = std::env::var("VF_BETA").ok().map(|s| s.parse().unwrap()).unwrap_or(3.5);
+        let cfg = Config { exact_fallback_margin: 0.0, beta, ..Config::default() };
         let o = MeshOracle::new(&mesh.0, &mesh.1, &cfg).unwrap();
         let t = std::time::Instant::now();
         let w = o.winding_numbers(&queries, WindingMode::Fast).unwrap();
