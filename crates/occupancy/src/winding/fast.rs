@@ -390,16 +390,13 @@ pub(crate) fn simd_level() -> Simd {
     use std::sync::OnceLock;
     static LEVEL: OnceLock<Simd> = OnceLock::new();
     *LEVEL.get_or_init(|| {
-        let cap = std::env::var("VORONOI_FIT_SIMD").unwrap_or_default();
-        let avx512 = simd_supported(Simd::Avx512);
-        let avx2 = simd_supported(Simd::Avx2);
-        match cap.as_str() {
-            "sse2" => Simd::Sse2,
-            "avx2" if avx2 => Simd::Avx2,
-            _ if avx512 && cap.is_empty() => Simd::Avx512,
-            _ if avx2 => Simd::Avx2,
-            _ => Simd::Sse2,
-        }
+        // Widest first; a cap (any other value is ignored) removes the wider levels.
+        let allowed: &[Simd] = match std::env::var("VORONOI_FIT_SIMD").as_deref() {
+            Ok("sse2") => &[Simd::Sse2],
+            Ok("avx2") => &[Simd::Avx2, Simd::Sse2],
+            _ => &[Simd::Avx512, Simd::Avx2, Simd::Sse2],
+        };
+        allowed.iter().copied().find(|&level| simd_supported(level)).unwrap_or(Simd::Sse2)
     })
 }
 
@@ -484,7 +481,8 @@ fn packet<const L: usize>(
         qy[i] = q[1];
         qz[i] = q[2];
     }
-    let all: LaneMask = if n == 32 { LaneMask::MAX } else { (1 << n) - 1 };
+    const { assert!(L <= LaneMask::BITS as usize, "one mask bit per lane") };
+    let all: LaneMask = if n == LaneMask::BITS as usize { LaneMask::MAX } else { (1 << n) - 1 };
     let mut sum = [0.0f64; L];
     stack.clear();
     stack.push((0, all));
