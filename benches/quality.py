@@ -35,7 +35,10 @@ Methods, per mesh and number of sites K (floats = 3K):
 Every output is measured by `voronoi-fit eval INPUT OUTPUT --json`: certified Hausdorff
 interval (upper end, % of the input's bounding-box diagonal), Chamfer L1 (% of the
 diagonal), F-score at 0.3% of the diagonal, normal consistency, IoU, and validity (closed,
-manifold, self-intersections, components, genus).
+manifold, self-intersections, components, genus). The CSV also has `boundary_hausdorff_pct`
+and `interior_share` (eval's `solid_boundary`: the Hausdorff distance with the input's faces
+that lie inside its own solid left out, a sampled estimate; the share of such faces), which
+tell a union's buried faces apart from a method's error.
 
 Output: DIR/quality_results.csv and DIR/quality_results.md (DIR = benches/ unless --out),
 one row per mesh x K x method, a summary of medians per method, and PNG renders of input
@@ -79,7 +82,7 @@ TIMEOUT = 3600
 FIELDS = [
     "mesh", "K", "method", "status", "error", "size", "bytes", "vertices", "triangles",
     "hausdorff_hi_pct", "hausdorff_lo_pct", "chamfer_l1_pct", "fscore", "normal_consistency", "iou",
-    "valid_solid", "closed", "manifold", "self_intersecting", "components", "genus",
+    "boundary_hausdorff_pct", "interior_share", "valid_solid", "closed", "manifold", "self_intersecting", "components", "genus",
     "seconds", "seconds_fit", "notes", "output",
 ]
 
@@ -215,6 +218,10 @@ def evaluate(a, mesh, pred):
         "hausdorff_hi_pct": 100 * hd["hi"] / diag, "hausdorff_lo_pct": 100 * hd["lo"] / diag,
         "chamfer_l1_pct": 100 * s["chamfer_l1"] / diag, "fscore": s["fscore"],
         "normal_consistency": s["normal_consistency"], "iou": (ev.get("iou") or {}).get("iou"),
+        # The Hausdorff distance to the solid's boundary only (faces inside the input's own
+        # solid left out; a sampled estimate): what any closed surface can reach on unions.
+        "boundary_hausdorff_pct": 100 * (ev.get("solid_boundary") or {}).get("hausdorff_estimate", float("nan")) / diag,
+        "interior_share": (ev.get("solid_boundary") or {}).get("interior_share"),
         "valid_solid": v.get("is_valid_solid"), "closed": v.get("is_closed"), "manifold": v.get("is_manifold"),
         "self_intersecting": v.get("self_intersecting"), "components": v.get("num_components"), "genus": v.get("genus"),
     }
@@ -315,18 +322,18 @@ def seconds(r):
 
 def table_rows(rows):
     out = [
-        "| mesh | K | method | size | bytes | Hausdorff hi % | Chamfer L1 % | F-score | normal cons. | IoU | validity | components | s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| mesh | K | method | size | bytes | Hausdorff hi % | boundary H % | Chamfer L1 % | F-score | normal cons. | IoU | validity | components | s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         if r["status"] != "ok":
             err = r["error"].replace("|", "/")
-            out.append(f"| {r['mesh']} | {r['K']} | {r['method']} | failed: {err[:160]} | | | | | | | | | |")
+            out.append(f"| {r['mesh']} | {r['K']} | {r['method']} | failed: {err[:160]} | | | | | | | | | | |")
             continue
         size = r["size"] + (" (the input: within the budget)" if "not decimated" in (r.get("notes") or "") else "")
         out.append(
             f"| {r['mesh']} | {r['K']} | {r['method']} | {size} | {r['bytes']:,} | {fmt(r['hausdorff_hi_pct'], '.3f')} | "
-            f"{fmt(r['chamfer_l1_pct'], '.4f')} | {fmt(r['fscore'], '.3f')} | {fmt(r['normal_consistency'], '.3f')} | "
+            f"{fmt(r.get('boundary_hausdorff_pct'), '.3f')} | {fmt(r['chamfer_l1_pct'], '.4f')} | {fmt(r['fscore'], '.3f')} | {fmt(r['normal_consistency'], '.3f')} | "
             f"{fmt(r['iou'], '.3f')} | {validity(r)} | {r.get('components', '')} | {seconds(r)} |"
         )
     return "\n".join(out)

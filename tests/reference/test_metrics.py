@@ -9,6 +9,10 @@
   vertex-only value is too low (about 20% below lo);
 - Chamfer L1 and IoU agree with independent estimates (trimesh samples + libigl distances,
   `igl.winding_number` on uniform points) within their sampling error;
+- the solid-boundary split (`solid_boundary`) on a box with a fin sunk into it (faces
+  inside the solid): the share of interior samples and the largest distances from boundary
+  and interior samples agree with trimesh samples classified by `igl.winding_number` on
+  both sides and measured by `igl.point_mesh_squared_distance`;
 - bad inputs exit with code 2 and name the file.
 
 Every mesh is written as a float32 binary STL so that the CLI and libigl see bit-identical
@@ -66,6 +70,12 @@ def pairs():
     ico4 = icosphere(4)
     diag = lambda V: float(np.linalg.norm(V.max(0) - V.min(0)))  # noqa: E731
     rot = trimesh.transformations.rotation_matrix(0.05, [1, 2, 3])[:3, :3]
+    # A CAD union left as two bodies: the fin's bottom and the box's top under the fin
+    # lie inside the solid.
+    box = trimesh.creation.box(bounds=[[-0.5, -0.5, 0.0], [0.5, 0.5, 0.3]])
+    fin = trimesh.creation.box(bounds=[[-0.4, -0.05, 0.2], [0.4, 0.05, 0.8]])
+    box_fin = trimesh.util.concatenate([box, fin])
+    box_fin = (np.asarray(box_fin.vertices, dtype=np.float64), np.asarray(box_fin.faces, dtype=np.int64))
     return {
         # 3,674 -> 228 faces; here igl.hausdorff is about 20% too low.
         "bunny_vs_decimation": (bunny, decimated(*bunny, 1 / 16, qslim=True)),
@@ -73,6 +83,7 @@ def pairs():
         "icosphere_vs_decimation": (ico4, decimated(*ico4, 1 / 10)),
         "icosphere3_vs_scaled_icosphere1": (icosphere(3), icosphere(1, 1.1)),
         "soup_vs_moved_soup": (soup, (soup[0] @ rot.T + 0.01 * diag(soup[0]), soup[1])),
+        "box_fin_vs_moved_box_fin": (box_fin, (box_fin[0] @ rot.T + 0.01, box_fin[1])),
         "teapot_vs_noisy_teapot": (
             teapot,
             (teapot[0] + rng.normal(scale=2e-3 * diag(teapot[0]), size=teapot[0].shape), teapot[1]),
@@ -160,6 +171,28 @@ def test_chamfer_and_iou_agree_with_independent_estimates(evaluated, name):
         wb = np.abs(igl.winding_number(VB, FB, q)) >= 0.5
         iou = (wa & wb).sum() / max((wa | wb).sum(), 1)
         assert abs(r["iou"]["iou"] - iou) <= 0.01, (r["iou"], iou)
+
+
+def test_solid_boundary_split_agrees_with_igl(evaluated):
+    VA, FA, VB, FB, r, _, _ = evaluated["box_fin_vs_moved_box_fin"]
+    b = r["solid_boundary"]
+    n = 200_000
+    mesh = trimesh.Trimesh(VA, FA, process=False)
+    pts, fi = trimesh.sample.sample_surface(mesh, n, seed=11)
+    nrm = mesh.face_normals[fi]
+    eps = 1e-6 * np.linalg.norm(VA.max(0) - VA.min(0))
+    inside = [np.abs(igl.winding_number(VA, FA, pts + s * eps * nrm)) >= 0.5 for s in (1.0, -1.0)]
+    interior = inside[0] & inside[1]
+    d = np.sqrt(igl.point_mesh_squared_distance(pts, VB, FB)[0])
+    share = interior.mean()
+    sd = np.sqrt(share * (1 - share) / b["num_samples"]) + np.sqrt(share * (1 - share) / n)
+    assert 0.02 < share < 0.2 and abs(b["interior_share"] - share) <= 4 * sd, (b, share)
+    # Sampled maxima of smooth distance fields: within 2% of each other.
+    for key, sel in (("max_boundary_to_prediction", ~interior), ("max_interior_to_prediction", interior)):
+        want = d[sel].max()
+        assert abs(b[key] - want) <= 0.02 * want, (key, b[key], want)
+    assert b["hausdorff_estimate"] <= r["hausdorff"]["hi"]
+    assert b["hausdorff_estimate"] >= max(b["max_boundary_to_prediction"], r["hausdorff"]["directed_witness"][1])
 
 
 def test_validity_of_closed_and_open_predictions(evaluated):

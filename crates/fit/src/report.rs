@@ -20,6 +20,10 @@ pub struct InputReport {
     pub is_manifold: bool,
     /// Signed volume (input units³; origin-referenced for open meshes).
     pub signed_volume: f64,
+    /// Triangles turned to agree with their neighbours before the solid was built
+    /// ([`mesh_io::orient_consistently`]): the winding-number solid is that of the
+    /// consistently oriented mesh.
+    pub reoriented: mesh_io::Reorientation,
 }
 
 /// Settings of the run.
@@ -329,6 +333,17 @@ impl FitReport {
             ),
             _ => String::new(),
         };
+        let r = &self.input.reoriented;
+        let reoriented = if r.flipped_triangles > 0 {
+            format!(
+                " {} of the input's triangles (in {} piece(s)) were turned around to agree with their neighbours \
+                 before the solid was built: flipped against the rest of their body, they turn part of it inside out \
+                 for the winding number.",
+                r.flipped_triangles, r.pieces_changed
+            )
+        } else {
+            String::new()
+        };
         let interior = match (self.solid.interior_surface_share, self.solid.interior_surface_samples_dropped) {
             (Some(share), dropped) if dropped > 0 => format!(
                 " {:.1}% of the input's surface is not on the solid's boundary (the same side of the solid on \
@@ -338,6 +353,7 @@ impl FitReport {
             ),
             _ => String::new(),
         };
+        let interior = format!("{reoriented}{interior}");
         let interior = if self.solid.cap_samples > 0 {
             format!(
                 "{interior} The solid closes the input's holes by the |winding number| = 0.5 surface; {} points of \

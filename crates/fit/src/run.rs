@@ -36,6 +36,7 @@ struct Prepared {
     transform: UnitCubeTransform,
     unit: TriMesh,
     topology: TopologyReport,
+    reoriented: mesh_io::Reorientation,
 }
 
 fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
@@ -47,9 +48,13 @@ fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
     let transform = UnitCubeTransform::of_mesh(&mesh, config.sampling.margin).ok_or_else(|| {
         FitError::Input(format!("{name}: the mesh has no extent (all vertices coincide) or non-finite coordinates"))
     })?;
-    let unit = transform.mesh_to_unit(&mesh);
+    // The solid, the samples' normals and the carving use a copy whose pieces agree on
+    // their orientation (triangles flipped against their neighbours turn part of a body
+    // inside out for the winding number); the input itself, and the metrics against it,
+    // stay as given.
+    let (unit, reoriented) = mesh_io::orient_consistently(&transform.mesh_to_unit(&mesh));
     let topology = TopologyReport::of(&mesh);
-    Ok(Prepared { mesh, transform, unit, topology })
+    Ok(Prepared { mesh, transform, unit, topology, reoriented })
 }
 
 /// Stage timer.
@@ -192,6 +197,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
             is_closed: p.topology.is_closed,
             is_manifold: p.topology.is_manifold,
             signed_volume: p.topology.signed_volume,
+            reoriented: p.reoriented.clone(),
         },
         settings: SettingsReport {
             train: state.config.clone(),

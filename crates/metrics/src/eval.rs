@@ -5,6 +5,7 @@ use std::time::Instant;
 use mesh_io::TriMesh;
 use serde::Serialize;
 
+use crate::boundary::{solid_boundary, SolidBoundary};
 use crate::hausdorff::{certify, CertifiedOptions, DistanceMesh, HausdorffInterval, Sides};
 use crate::iou::{volumetric_iou, IouResult};
 use crate::surface::{surface_metrics_of, SurfaceMetrics, SurfaceOptions};
@@ -40,6 +41,9 @@ pub struct EvalReport {
     pub iou: Option<IouResult>,
     /// Validity of the prediction (`None` when skipped).
     pub prediction_validity: Option<Validity>,
+    /// Distances to the part of the reference that bounds its solid, interior faces left
+    /// out ([`crate::boundary`]): what a closed surface can reach on CAD unions.
+    pub solid_boundary: SolidBoundary,
     /// Bounding-box diagonal of the reference, mesh units.
     pub reference_diagonal: f64,
     /// Wall time, seconds.
@@ -47,8 +51,8 @@ pub struct EvalReport {
 }
 
 /// Evaluates `prediction` against `reference`: libigl-compatible and certified Hausdorff,
-/// Chamfer L1/L2, F-score, normal consistency, volumetric IoU and the prediction's
-/// validity.
+/// Chamfer L1/L2, F-score, normal consistency, volumetric IoU, the prediction's validity
+/// and the distances to the reference's solid boundary.
 ///
 /// # Errors
 /// [`MetricsError`] for an empty, non-finite or out-of-range mesh (named "reference" or
@@ -71,6 +75,13 @@ pub fn evaluate(reference: &TriMesh, prediction: &TriMesh, opts: &EvalOptions) -
     } else {
         None
     };
+    let boundary = solid_boundary(
+        &r,
+        &p,
+        opts.surface.num_samples,
+        opts.surface.seed.wrapping_add(3),
+        hausdorff.directed_witness[1],
+    )?;
     let prediction_validity = (!opts.skip_validity).then(|| validity(prediction));
     Ok(EvalReport {
         format_version: 1,
@@ -79,6 +90,7 @@ pub fn evaluate(reference: &TriMesh, prediction: &TriMesh, opts: &EvalOptions) -
         surface,
         iou,
         prediction_validity,
+        solid_boundary: boundary,
         reference_diagonal: reference.diagonal(),
         seconds: t0.elapsed().as_secs_f64(),
     })

@@ -14,6 +14,9 @@
 //!   default), see [`surface`];
 //! - [`volumetric_iou`]: IoU of the two solids by generalized winding numbers on uniform
 //!   samples, see [`iou`];
+//! - [`solid_boundary`]: the reference's samples split into interior faces (the solid on
+//!   both sides) and the solid's boundary, with their distances to the prediction, see
+//!   [`boundary`];
 //! - [`validity()`]: closed, manifold, oriented, self-intersections (exact), components,
 //!   genus, from `mesh_io::TopologyReport` and `crust::check`;
 //! - [`evaluate`]: all of the above in one [`EvalReport`] (`voronoi-fit eval`).
@@ -25,6 +28,7 @@
 //! point-triangle code; every parallel loop works in fixed chunks, so results do not depend
 //! on the thread count.
 
+pub mod boundary;
 pub mod error;
 pub mod eval;
 pub mod hausdorff;
@@ -32,6 +36,7 @@ pub mod iou;
 pub mod surface;
 pub mod validity;
 
+pub use boundary::{solid_boundary, SolidBoundary};
 pub use error::MetricsError;
 pub use eval::{evaluate, EvalOptions, EvalReport};
 pub use hausdorff::{

@@ -110,13 +110,72 @@ fn evaluate_reports_everything() {
     assert!(r.iou.as_ref().unwrap().iou.unwrap() > 0.9);
     assert!(r.prediction_validity.as_ref().unwrap().is_valid_solid);
     let json = serde_json::to_value(&r).unwrap();
-    for key in ["hausdorff_libigl", "hausdorff", "surface", "iou", "prediction_validity", "reference_diagonal"] {
+    // A sphere has no interior faces: every sample is a boundary sample.
+    assert_eq!(r.solid_boundary.interior_share, 0.0);
+    assert!(r.solid_boundary.hausdorff_estimate <= h.hi);
+    for key in [
+        "hausdorff_libigl",
+        "hausdorff",
+        "surface",
+        "iou",
+        "prediction_validity",
+        "solid_boundary",
+        "reference_diagonal",
+    ] {
         assert!(json.get(key).is_some(), "{key} missing in {json}");
     }
     // Skips.
     let r =
         evaluate(&reference, &prediction, &EvalOptions { iou_samples: Some(0), skip_validity: true, ..opts }).unwrap();
     assert!(r.iou.is_none() && r.prediction_validity.is_none());
+}
+
+/// `a` and `b` as one mesh (no welding).
+fn union_of(a: &TriMesh, b: &TriMesh) -> TriMesh {
+    let n = a.positions.len() as u32;
+    TriMesh {
+        positions: a.positions.iter().chain(&b.positions).copied().collect(),
+        triangles: a.triangles.iter().copied().chain(b.triangles.iter().map(|t| t.map(|v| v + n))).collect(),
+    }
+}
+
+#[test]
+fn interior_faces_are_told_apart_from_the_solid_boundary() {
+    // A unit box with a second box [0.4, 0.6]³ inside it (faces inside the solid, as in a CAD
+    // union). The box alone is the solid's exact boundary: the certified distance is the
+    // inner box's depth, 0.4 (its face centres, e.g. (0.5, 0.5, 0.4)), while nothing on the
+    // boundary is away from the prediction.
+    let outer = mesh_io::shapes::cuboid([0.0; 3], [1.0; 3]);
+    let inner = mesh_io::shapes::cuboid([0.4; 3], [0.6; 3]);
+    let reference = union_of(&outer, &inner);
+    let opts =
+        EvalOptions { surface: SurfaceOptions { num_samples: 40_000, ..Default::default() }, ..Default::default() };
+    let r = evaluate(&reference, &outer, &opts).unwrap();
+    assert!((r.hausdorff.hi - 0.4).abs() < 1e-5 && (r.hausdorff.lo - 0.4).abs() < 1e-5, "{:?}", r.hausdorff);
+    let b = &r.solid_boundary;
+    // Area share of the inner box: 0.24 / 6.24, within three binomial standard deviations.
+    let want: f64 = 0.24 / 6.24;
+    let sd = (want * (1.0 - want) / 40_000.0).sqrt();
+    assert!((b.interior_share - want).abs() < 3.0 * sd, "{b:?}");
+    assert!(b.max_boundary_to_prediction < 1e-12, "{b:?}");
+    assert!(b.max_interior_to_prediction > 0.39 && b.max_interior_to_prediction <= 0.4 + 1e-12, "{b:?}");
+    assert!(b.hausdorff_estimate < 1e-12, "{b:?}");
+    // A prediction 0.05 too large on every side: the boundary is 0.05 away (up to 0.05·√3
+    // at corners that are not sampled exactly), the inner box 0.45.
+    let grown = mesh_io::shapes::cuboid([-0.05; 3], [1.05; 3]);
+    let r = evaluate(&reference, &grown, &opts).unwrap();
+    let b = &r.solid_boundary;
+    assert!(b.max_boundary_to_prediction >= 0.05 - 1e-12 && b.max_boundary_to_prediction < 0.05 * 3f64.sqrt());
+    assert!(b.max_interior_to_prediction > 0.44 && b.max_interior_to_prediction <= 0.45 + 1e-12, "{b:?}");
+    // The other direction (crust corners to the reference) is certified: 0.05·√3.
+    assert!((b.hausdorff_estimate - 0.05 * 3f64.sqrt()).abs() < 1e-5, "{b:?}");
+    // An open sheet has outside on both sides: all boundary, none interior.
+    let sheet = TriMesh {
+        positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        triangles: vec![[0, 1, 2], [0, 2, 3]],
+    };
+    let r = evaluate(&sheet, &outer, &EvalOptions { iou_samples: Some(0), ..opts }).unwrap();
+    assert_eq!(r.solid_boundary.interior_share, 0.0);
 }
 
 #[test]

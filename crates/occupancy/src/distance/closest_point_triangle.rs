@@ -28,7 +28,9 @@ pub fn closest_point_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
         return b;
     }
     let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+    // Each edge region divides by the edge's squared length (d1 − d3 = |ab|², and so on):
+    // a zero-length edge (two corners coincide) skips to the degenerate case below.
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0 {
         let v = d1 / (d1 - d3);
         return add(a, scale(ab, v));
     }
@@ -39,12 +41,12 @@ pub fn closest_point_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
         return c;
     }
     let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0 {
         let w = d2 / (d2 - d6);
         return add(a, scale(ac, w));
     }
     let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
         return add(b, scale(sub(c, b), w));
     }
@@ -130,5 +132,24 @@ mod tests {
         assert!((norm_squared(sub(p, q)) - 1.0).abs() < 1e-15, "{q:?}");
         let q = closest_point_triangle(p, [0.0; 3], [0.0; 3], [0.0; 3]);
         assert_eq!(q, [0.0; 3]);
+    }
+
+    #[test]
+    fn two_coincident_corners_are_a_segment() {
+        // A triangle with a repeated corner (as rounding to float32 leaves in crusts) was
+        // 0/0 in the edge region of its zero-length edge: a NaN distance in `eval`'s
+        // Chamfer. Every order of the corners, and points around the segment and beyond
+        // its ends, must give the segment's closest point.
+        let (s, t) = ([0.1, -0.2, 0.3], [1.1, 0.4, -0.2]);
+        let pts = [[0.0, 0.0, 0.0], [0.5, 1.0, 0.2], [2.0, 0.5, 0.0], [-1.0, -0.5, 0.7], [0.6, 0.1, 0.05], s, t];
+        for p in pts {
+            let want = closest_point_segment(p, s, t);
+            for (a, b, c) in [(s, s, t), (s, t, s), (t, s, s), (t, t, s), (s, t, t), (t, s, t)] {
+                let q = closest_point_triangle(p, a, b, c);
+                assert!(q.iter().all(|x| x.is_finite()), "{p:?} on {a:?} {b:?} {c:?}: {q:?}");
+                let (d, w) = (norm_squared(sub(p, q)), norm_squared(sub(p, want)));
+                assert!((d - w).abs() <= 1e-15 * (1.0 + w), "{p:?} on {a:?} {b:?} {c:?}: {d} vs {w}");
+            }
+        }
     }
 }
