@@ -27,6 +27,7 @@ pub mod crust_step;
 pub mod data;
 pub mod error;
 pub mod grow;
+pub mod guard;
 pub mod options;
 pub mod progress;
 pub mod report;

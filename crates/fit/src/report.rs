@@ -264,6 +264,9 @@ pub struct FitReport {
     pub relabelled_sites: Option<usize>,
     /// Sites inserted where the crust strayed from the input (absent when off).
     pub carving: Option<crate::carve::CarveReport>,
+    /// Outside mirror sites that cut inside cells at the input's bounding box (with
+    /// carving; absent when off).
+    pub guard: Option<crate::guard::GuardReport>,
     /// Sites removed last because they change neither the crust nor the occupancy (absent
     /// when off).
     pub pruning: Option<PruneReport>,
@@ -314,6 +317,31 @@ impl FitReport {
             }
             _ => String::new(),
         };
+        let guarded = match &self.guard {
+            Some(g) if g.inserted_per_round.iter().sum::<usize>() > 0 => {
+                // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
+                let of_diag = self
+                    .carving
+                    .as_ref()
+                    .filter(|r| r.tolerance > 0.0)
+                    .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
+                format!(
+                    " {} outside sites were added as mirror images of inside sites across the input's bounding box, \
+                     where their cells ran past it (the crust reached {:.3}% of the diagonal beyond the box, now \
+                     {:.3}%{}).",
+                    g.inserted_per_round.iter().sum::<usize>(),
+                    100.0 * g.beyond_before * of_diag,
+                    100.0 * g.beyond_after * of_diag,
+                    if g.skipped_outside_cube > 0 {
+                        format!("; {} mirrors would have left the unit cube and were not added", g.skipped_outside_cube)
+                    } else {
+                        String::new()
+                    }
+                )
+            }
+            _ => String::new(),
+        };
+        let carved = format!("{carved}{guarded}");
         let polished = match &self.polish {
             Some(p) => format!(
                 " The sites were then polished onto the surface samples ({} steps of VoroMesh's bisector loss, \

@@ -165,6 +165,15 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         }
         None => None,
     };
+    // With carving: no crust outside the input's bounding box (not on a thin shell, whose
+    // solid reaches past the surface by its half-thickness).
+    let guard = match config.carve {
+        Some(c) if !target.places_sites() => {
+            let (lo, hi) = p.unit.bounding_box();
+            Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, c * diagonal)?)
+        }
+        _ => None,
+    };
     let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
     let checked = crust_of(&sites, &labels, &p.transform, config.output_precision)?;
     let crust_mesh = checked.written.mesh.clone();
@@ -221,6 +230,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         polish,
         relabelled_sites: config.relabel.then_some(num_relabelled),
         carving,
+        guard,
         pruning,
         accuracy_target: None,
         outputs: OutputsReport::default(),

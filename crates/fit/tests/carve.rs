@@ -105,3 +105,29 @@ fn sites_that_would_stand_by_another_face_are_left_out() {
     let on_edge = pair([0.7, 0.5, 0.7], [h, 0.0, h]);
     assert_eq!(fit::carve::clear_of_the_input(&oracle, on_edge.clone(), t).unwrap(), on_edge);
 }
+
+#[test]
+fn the_guard_cuts_a_spike_at_the_bounding_box() {
+    // The same gap: the spike runs up out of the sphere's bounding box to the unit cube's
+    // boundary sites. Mirrors of the inside sites across the box's top end it there, and
+    // the crust below the top is what it was (the guard never changes the box's inside).
+    let sphere = icosphere(5);
+    let t = UnitCubeTransform::of_mesh(&sphere, 0.05).unwrap();
+    let unit: TriMesh = t.mesh_to_unit(&sphere);
+    let oracle = MeshOracle::from_mesh(&unit, &occupancy::Config::default()).unwrap();
+    let (mut sites, mut labels) = pairs_with_a_gap([0.5; 3], 0.45, 2000, 0.995);
+    let (lo, hi) = unit.bounding_box();
+    let top = |s: &[[f64; 3]], l: &[bool]| {
+        let c = crust::Crust::extract(s, l, &crust::CrustConfig::default()).unwrap();
+        c.mesh.positions.iter().fold(0.0f64, |m, p| m.max(p[2]))
+    };
+    let before = top(&sites, &labels);
+    assert!(before > hi[2] + 0.02, "the spike leaves the box: {before} against {}", hi[2]);
+    let n0 = sites.len();
+    let r = fit::guard::guard(&mut sites, &mut labels, lo, hi, 0.004).unwrap();
+    assert!(r.inserted_per_round.iter().sum::<usize>() > 0 && r.skipped_outside_cube == 0, "{r:?}");
+    assert!(r.beyond_after <= 0.004 && r.beyond_before > 0.02, "{r:?}");
+    assert!(top(&sites, &labels) <= hi[2] + 0.004);
+    assert!(labels[n0..].iter().all(|&l| !l) && sites[n0..].iter().all(|p| p[2] > hi[2]));
+    assert!(farthest(&sites, &labels, &oracle) < 0.5 * (before - hi[2]) + 0.004);
+}
