@@ -6,8 +6,8 @@
 //! (STL exports, hand-edited CAD), w no longer jumps by 1 across the body's surface, so
 //! part of the body reads as outside and a region outside the body as inside (on the
 //! quality benchmark's `multibody`, a box with 6 of its 12 triangles flipped: a wedge of
-//! "solid" grows out of one face and the fit reproduces it faithfully, Hausdorff 11% of
-//! the diagonal; with the box consistently oriented, 0.06%).
+//! "solid" grows out of one face and the fit reproduces it faithfully, Hausdorff 12.7% of
+//! the diagonal; with the box consistently oriented, 0.05%).
 //!
 //! [`orient_consistently`] repairs exactly that and nothing else: triangles are joined
 //! across manifold edges (edges with exactly two triangles), each such piece is oriented
