@@ -13,10 +13,12 @@ instead: one row per pair, columns input/crust for each view (`--views front,sid
 default). `--up y|z` names the mesh's up axis (default y; CAD/STL files are often z-up).
 
 How: each view is an orthographic projection; triangles are flat-shaded (two-sided
-Lambert from a light above-left of the camera, plus ambient) and drawn far-to-near
-(painter's algorithm by centroid depth; triangles longer than 4% of the frame are split for
-the ordering only) as one PolyCollection of 2D polygons per panel, with edges in the face
-colour so no seams show (no wireframe). Faces seen from behind (back faces: open
+Lambert from a light above-left of the camera, plus ambient) and rasterized with a depth
+buffer at 3x3 samples per pixel, averaged (no wireframe). A triangle covers the pixels
+whose sample points it contains, so a sliver much thinner than a pixel shows as much as
+its area: the painter's algorithm drawn before (a PolyCollection with edges in the face
+colour) gave every sliver and step face of a crust a line at least a pixel wide, and
+smooth crusts looked speckled. Faces seen from behind (back faces: open
 meshes, inward-facing bodies, wrong orientation) are drawn in orange, so orientation
 problems are visible. Meshes of ~200k triangles take a few seconds per panel. Meshes are
 read with trimesh (GLB scenes flattened with their node transforms).
@@ -30,7 +32,6 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.collections import PolyCollection  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from quality_meshes import load_mesh  # noqa: E402
@@ -61,45 +62,52 @@ def frame_of(V):
     return (lo + hi) / 2, max(np.linalg.norm(hi - lo) / 2, 1e-300)
 
 
-def split_large(tri, max_edge, rounds=6):
-    """Split triangles (k,3,3) with an edge longer than max_edge into four (midpoints), up to
-    `rounds` times: the painter's algorithm orders by centroid depth, which misorders long
-    triangles next to small ones (CAD inputs, big flat faces). Rendering only."""
-    for _ in range(rounds):
-        e = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).max(1)
-        big = e > max_edge
-        if not big.any():
-            break
-        t = tri[big]
-        a, b, c = t[:, 0], t[:, 1], t[:, 2]
-        ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
-        sub = np.concatenate([np.stack(x, 1) for x in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])
-        tri = np.concatenate([tri[~big], sub])
-    return tri
+SS = 3  # samples per pixel along each axis
 
 
-def draw(ax, V, F, R, center, scale):
-    """One panel: orthographic, flat two-sided Lambert, painter's order."""
+def draw(ax, V, F, R, center, scale, pixels=380):
+    """One panel: orthographic, flat two-sided Lambert, depth buffer, SSxSS samples a pixel."""
     ax.set_xlim(-1.02, 1.02)
     ax.set_ylim(-1.02, 1.02)
     ax.set_aspect("equal")
     ax.axis("off")
-    if len(F) == 0:
-        return
-    P = (V - center) @ R.T / scale
-    tri = split_large(P[F], 0.08)  # the frame is [-1, 1]^2
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    ln = np.linalg.norm(n, axis=1)
-    n = n / np.where(ln > 0, ln, 1)[:, None]
-    back = n[:, 2] < 0  # facing away from the viewer
-    lam = np.abs(n @ LIGHT)  # two-sided
-    shade = (0.28 + 0.72 * lam)[:, None]
-    colors = np.where(back[:, None], BACK_COLOR, FRONT_COLOR) * shade
-    colors = np.clip(colors, 0, 1)
-    order = np.argsort(tri[:, :, 2].mean(1), kind="stable")  # far first
-    pc = PolyCollection(tri[order][:, :, :2], facecolors=colors[order], edgecolors=colors[order],
-                        linewidths=0.25, antialiaseds=False)
-    ax.add_collection(pc)
+    n_px = pixels * SS
+    img = np.ones((n_px, n_px, 3))
+    if len(F):
+        P = (V - center) @ R.T / scale  # the frame is [-1.02, 1.02]^2
+        XY = (P[:, :2] + 1.02) / 2.04 * n_px
+        Z = P[:, 2]
+        tri = P[F]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        ln = np.linalg.norm(n, axis=1)
+        n = n / np.where(ln > 0, ln, 1)[:, None]
+        back = n[:, 2] < 0  # facing away from the viewer
+        shade = (0.28 + 0.72 * np.abs(n @ LIGHT))[:, None]
+        colors = np.clip(np.where(back[:, None], BACK_COLOR, FRONT_COLOR) * shade, 0, 1)
+        depth = np.full((n_px, n_px), -np.inf)
+        for f, col in zip(F, colors):
+            (ax_, ay), (bx, by), (cx, cy) = XY[f]
+            x0, x1 = int(max(0, np.floor(min(ax_, bx, cx)))), int(min(n_px - 1, np.ceil(max(ax_, bx, cx))))
+            y0, y1 = int(max(0, np.floor(min(ay, by, cy)))), int(min(n_px - 1, np.ceil(max(ay, by, cy))))
+            if x1 < x0 or y1 < y0:
+                continue
+            d = (bx - ax_) * (cy - ay) - (cx - ax_) * (by - ay)
+            if d == 0:
+                continue
+            xs, ys = np.meshgrid(np.arange(x0, x1 + 1) + 0.5, np.arange(y0, y1 + 1) + 0.5)
+            w1 = ((xs - ax_) * (cy - ay) - (cx - ax_) * (ys - ay)) / d
+            w2 = ((bx - ax_) * (ys - ay) - (xs - ax_) * (by - ay)) / d
+            w0 = 1 - w1 - w2
+            inside = (w0 >= 0) & (w1 >= 0) & (w2 >= 0)
+            if not inside.any():
+                continue
+            z = w0 * Z[f[0]] + w1 * Z[f[1]] + w2 * Z[f[2]]
+            sub = depth[y0:y1 + 1, x0:x1 + 1]
+            upd = inside & (z > sub)
+            sub[upd] = z[upd]
+            img[y0:y1 + 1, x0:x1 + 1][upd] = col
+    img = img.reshape(pixels, SS, pixels, SS, 3).mean(axis=(1, 3))
+    ax.imshow(img, origin="lower", extent=(-1.02, 1.02, -1.02, 1.02), interpolation="nearest")
 
 
 def render_columns(paths, labels, out, up="y", views=("front", "side", "top"), title=None, panel=3.4, dpi=110):
