@@ -277,16 +277,10 @@ fn f_slack(f0: f64) -> f64 {
 fn boundary_samples(mesh: &TriMesh, solid: &dyn Solid) -> Result<Option<Vec<[f64; 3]>>, FitError> {
     let sampler = occupancy::sample::SurfaceSampler::from_mesh(mesh).map_err(failure)?;
     let s = sampler.sample(BOUNDARY_SAMPLES, 0);
-    let eps = 1e-6 * mesh.diagonal();
-    let probes: Vec<[f64; 3]> = s
-        .points
-        .iter()
-        .zip(&s.normals)
-        .flat_map(|(p, n)| [1.0, -1.0].map(|sign| [0, 1, 2].map(|k| p[k] + sign * eps * n[k])))
-        .collect();
-    let inside = solid.inside(&probes);
-    let kept: Vec<[f64; 3]> =
-        s.points.iter().enumerate().filter(|&(i, _)| !(inside[2 * i] && inside[2 * i + 1])).map(|(_, p)| *p).collect();
+    let eps = metrics::BURIED_OFFSET * mesh.diagonal();
+    let Ok(is_buried) =
+        metrics::buried(&s.points, &s.normals, eps, |q| Ok::<_, std::convert::Infallible>(solid.inside(q)));
+    let kept: Vec<[f64; 3]> = s.points.iter().zip(&is_buried).filter(|(_, &b)| !b).map(|(p, _)| *p).collect();
     Ok((kept.len() < s.points.len()).then_some(kept))
 }
 

@@ -85,15 +85,20 @@ pub fn guard(
             .filter(|(p, &l)| l && (0..3).all(|k| p[k] > lo[k] && p[k] < hi[k]))
             .map(|(p, _)| *p)
             .collect();
+        if inside.is_empty() {
+            break;
+        }
+        let tree = soft_voronoi::knn::KnnTree::new(&inside);
+        let mut near = Vec::new();
         let mut added = 0;
         for v in far {
-            // The inside sites nearest to v: the inside sites of its tetrahedron.
-            let d2 = |p: &[f64; 3]| (0..3).map(|k| (p[k] - v[k]).powi(2)).sum::<f64>();
-            let nearest = inside.iter().map(d2).fold(f64::INFINITY, f64::min);
-            if !nearest.is_finite() {
-                break;
-            }
-            for s in inside.iter().filter(|p| d2(p) <= nearest * (1.0 + 1e-9) + 1e-30) {
+            // The inside sites nearest to v: the inside sites of its tetrahedron (at most
+            // four unless the sites are cospherical; eight are asked for).
+            tree.k_nearest(v, 8, &mut near);
+            let nearest = near.first().map_or(f64::INFINITY, |n| n.0);
+            let owners: Vec<[f64; 3]> =
+                near.iter().filter(|n| n.0 <= nearest * (1.0 + 1e-9) + 1e-30).map(|n| inside[n.1 as usize]).collect();
+            for s in &owners {
                 for k in 0..3 {
                     for (plane, out) in [(lo[k], v[k] < lo[k]), (hi[k], v[k] > hi[k])] {
                         if !out {

@@ -29,6 +29,31 @@ use serde::Serialize;
 use crate::hausdorff::DistanceMesh;
 use crate::MetricsError;
 
+/// The offset ε of [`buried`]'s probes, as a share of the mesh's bounding-box diagonal.
+pub const BURIED_OFFSET: f64 = 1e-6;
+
+/// Whether each surface sample (`points`, unit `normals`) is buried: `inside` puts both
+/// x + `eps`·n and x − `eps`·n inside the solid. `inside` gets all 2n probes in one call
+/// (x + εn, x − εn for each sample, in order). Shared by [`solid_boundary`] and the fit's
+/// carving, which asks its own solid.
+///
+/// # Errors
+/// Whatever `inside` returns.
+pub fn buried<E>(
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    eps: f64,
+    inside: impl FnOnce(&[[f64; 3]]) -> Result<Vec<bool>, E>,
+) -> Result<Vec<bool>, E> {
+    let probes: Vec<[f64; 3]> = points
+        .iter()
+        .zip(normals)
+        .flat_map(|(p, m)| [1.0, -1.0].map(|sign| [0, 1, 2].map(|k| p[k] + sign * eps * m[k])))
+        .collect();
+    let inside = inside(&probes)?;
+    Ok(inside.chunks_exact(2).map(|pair| pair[0] && pair[1]).collect())
+}
+
 /// Result of [`solid_boundary`], mesh units.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SolidBoundary {
@@ -72,14 +97,7 @@ pub fn solid_boundary(
     })?;
     let s = sampler.sample(n, seed);
     let oracle = MeshOracle::from_mesh(mesh, &Config::default())?;
-    let eps = 1e-6 * mesh.diagonal();
-    let probes: Vec<[f64; 3]> = s
-        .points
-        .iter()
-        .zip(&s.normals)
-        .flat_map(|(p, m)| [1.0, -1.0].map(|sign| [0, 1, 2].map(|k| p[k] + sign * eps * m[k])))
-        .collect();
-    let inside = oracle.inside(&probes)?;
+    let is_buried = buried(&s.points, &s.normals, BURIED_OFFSET * mesh.diagonal(), |q| oracle.inside(q))?;
     let mut dist = vec![0.0; n];
     dist.par_chunks_mut(1024).enumerate().for_each(|(c, o)| {
         let mut ws = Workspace::new();
@@ -89,7 +107,7 @@ pub fn solid_boundary(
     });
     let (mut interior, mut max_b, mut max_i, mut witness) = (0usize, 0.0f64, 0.0f64, None);
     for (i, &d) in dist.iter().enumerate() {
-        if inside[2 * i] && inside[2 * i + 1] {
+        if is_buried[i] {
             interior += 1;
             max_i = max_i.max(d);
         } else if witness.is_none() || d > max_b {

@@ -36,7 +36,7 @@ pub mod iou;
 pub mod surface;
 pub mod validity;
 
-pub use boundary::{solid_boundary, SolidBoundary};
+pub use boundary::{buried, solid_boundary, SolidBoundary, BURIED_OFFSET};
 pub use error::MetricsError;
 pub use eval::{evaluate, EvalOptions, EvalReport};
 pub use hausdorff::{
