@@ -111,9 +111,11 @@ pub struct Args {
     /// near ±0.5 beside most of the surface: a sheet).
     #[arg(long, default_value = "auto", value_parser = parse_solid)]
     pub solid: SolidRule,
-    /// Thickness of the shell solid as a fraction of the bounding-box diagonal (e.g. 0.01).
-    /// Default: about one site spacing.
-    #[arg(long)]
+    /// Thickness of the shell solid as a share of the bounding-box diagonal (`1%` or
+    /// `0.01`). Default: the thinnest of 0.3, 0.4, 0.5 and 0.7 times about one site spacing
+    /// whose crust keeps the topology and Hausdorff distance of the full spacing's, else
+    /// the full spacing (the report's `solid.thickness_search`).
+    #[arg(long, value_parser = parse_share)]
     pub shell_thickness: Option<f64>,
     /// Ask for an accuracy instead of a K: the certified Hausdorff distance to the input as
     /// a share of its bounding-box diagonal (`0.5%` or `0.005`). The fit starts at --sites

@@ -42,8 +42,9 @@ pub struct Sampling {
     /// Which solid the sites fit (absent in checkpoints written before it existed: auto).
     #[serde(default)]
     pub solid: SolidRule,
-    /// Thickness of the shell solid, a fraction of the diagonal (`None`: about one site
-    /// spacing, see [`shell_half_thickness`]).
+    /// Thickness of the shell solid, a fraction of the diagonal (`None`: the thinnest band
+    /// of `target::BAND_FACTORS` times about one site spacing ([`shell_half_thickness`])
+    /// whose crust holds, see `target::thinnest_band`).
     #[serde(default)]
     pub shell_thickness: Option<f64>,
 }
@@ -77,9 +78,9 @@ pub const SHELL_ABOVE: f64 = 0.5;
 pub const AMBIGUITY_SAMPLES: usize = 20_000;
 
 /// Half-thickness of the shell solid in unit-cube lengths: `thickness`·`diagonal`/2 when
-/// given, else √(A/K) for surface area A and K sites (half the spacing of K/2 mirrored
-/// pairs spread over both sides of the band, so each side is resolved), clamped to
-/// [0.1 %, 5 %] of the diagonal.
+/// given, else the default band √(A/K) for surface area A and K sites (half the spacing of
+/// K/2 mirrored pairs spread over both sides of the band), clamped to [0.1 %, 5 %] of the
+/// diagonal, from which `target::thinnest_band` tries thinner ones.
 pub fn shell_half_thickness(thickness: Option<f64>, area: f64, num_sites: usize, diagonal: f64) -> f64 {
     match thickness {
         Some(t) => 0.5 * t * diagonal,

@@ -351,14 +351,35 @@ impl FitReport {
             None => String::new(),
         };
         let shell = match (self.solid.half_thickness, self.solid.half_thickness_of_diagonal) {
-            (Some(h), Some(f)) => format!(
-                " The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
-                 and 0.75 in magnitude), so the sites fit a thin shell: the surface thickened by {:.4e} on each side ({:.2}% of the diagonal); the \
-                 crust is that shell's boundary.",
-                100.0 * self.solid.near_surface_ambiguous_share,
-                h,
-                100.0 * f
-            ),
+            (Some(h), Some(f)) => {
+                let search = match &self.solid.thickness_search {
+                    Some(trials) => {
+                        let kept = trials.iter().find(|t| t.kept).map_or(1.0, |t| t.factor);
+                        let broken = trials.iter().filter(|t| t.factor < kept).count();
+                        if kept < 1.0 {
+                            format!(
+                                " That is the thinnest band tried whose crust keeps the default band's topology and \
+                                 Hausdorff distance ({kept} of the default √(A/K); {broken} thinner one(s) did not)."
+                            )
+                        } else {
+                            format!(
+                                " No thinner band kept the default's topology and Hausdorff distance ({} tried), so \
+                                 the default √(A/K) stays.",
+                                trials.len() - 1
+                            )
+                        }
+                    }
+                    None => String::new(),
+                };
+                format!(
+                    " The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
+                     and 0.75 in magnitude), so the sites fit a thin shell: the surface thickened by {:.4e} on each side ({:.2}% of the diagonal); the \
+                     crust is that shell's boundary.{search}",
+                    100.0 * self.solid.near_surface_ambiguous_share,
+                    h,
+                    100.0 * f
+                )
+            }
             _ => String::new(),
         };
         let r = &self.input.reoriented;

@@ -155,7 +155,12 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     progress.stage(Stage::Crust);
     let num_relabelled =
         if config.relabel { relabel(&sites, &mut labels, trainer.config().num_sites, solid) } else { 0 };
-    let carving = match config.carve {
+    // Not on a thin shell kept as constructed: its sides are the triplets' bisectors
+    // already, and a carving pair (offset 0.3% of the diagonal) across a band thinner than
+    // that has both sites outside and punches a hole in it (libigl's lilium at a
+    // half-thickness of 0.24%: genus 0 → 260). At the default band no round was kept.
+    let carve = if target.places_sites() && !config.train_shell { None } else { config.carve };
+    let carving = match carve {
         Some(c) => {
             let k = trainer.config().num_sites;
             let tolerance = c * diagonal;

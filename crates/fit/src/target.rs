@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 
+use crust::output::{FrameMap, Precision};
 use mesh_io::TriMesh;
 use occupancy::sample::SurfaceSampler;
 use occupancy::MeshOracle;
@@ -76,6 +77,29 @@ pub struct SolidReport {
     /// [`cap_samples`]) added to the surface samples, so that the initialisation puts site
     /// pairs and the polish pulls bisectors there too (winding solid of an open mesh only).
     pub cap_samples: usize,
+    /// The thinner bands tried before settling on the shell's half-thickness (shell with
+    /// the default thickness and sites kept as constructed only; see [`thinnest_band`]).
+    pub thickness_search: Option<Vec<BandTrial>>,
+}
+
+/// One band tried by [`thinnest_band`]: its half-thickness, the crust's topology and its
+/// certified Hausdorff distance to the input, and whether it was taken.
+#[derive(Clone, Debug, Serialize)]
+pub struct BandTrial {
+    /// Half-thickness as a share of the default (√(A/K)).
+    pub factor: f64,
+    /// Half-thickness as a fraction of the input's bounding-box diagonal.
+    pub half_thickness_of_diagonal: f64,
+    /// Connected components of the crust of the sites as constructed.
+    pub components: usize,
+    /// Its genus (summed over components; the crust is closed and manifold, so known).
+    pub genus: Option<i64>,
+    /// Upper end of its certified Hausdorff interval to the input, a fraction of the
+    /// diagonal.
+    pub hausdorff_of_diagonal: f64,
+    /// Whether this band was kept (the default's own row is kept when no thinner one
+    /// passed).
+    pub kept: bool,
 }
 
 /// Surface samples probed first to decide whether the pool has interior surface at all.
@@ -306,24 +330,39 @@ pub(crate) fn choose<'a>(
             interior_surface_share: Some(interior),
             interior_surface_samples_dropped: dropped,
             cap_samples: caps,
+            thickness_search: None,
         };
         return Ok((Target::Winding(solid), report));
     }
-    let h = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
-    let solid = ShellSolid::new(oracle, unit, h);
-    data.occupancy = solid.inside(&data.points);
+    let h0 = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
     let k = config.train.num_sites;
     let m = data.surface.len().min(12 * k);
-    let (sites, labels, (triplets, rims)) = shell_sites(
-        unit,
-        sampler.total_area(),
-        &data.surface[..m],
-        &data.normals[..m],
-        &solid,
-        k,
-        data,
-        config.train.seed,
-    );
+    let place = |h: f64, data: &TrainingData| {
+        let solid = ShellSolid::new(oracle, unit, h);
+        let (sites, labels, counts) = shell_sites(
+            unit,
+            sampler.total_area(),
+            &data.surface[..m],
+            &data.normals[..m],
+            &solid,
+            k,
+            data,
+            config.train.seed,
+        );
+        (solid, sites, labels, counts)
+    };
+    let (h, thickness_search) = if s.shell_thickness.is_none() && !config.train_shell {
+        let boundary = config.train.boundary_sites.unwrap_or_else(|| (k as f64).sqrt().ceil() as usize);
+        let (h, trials) = thinnest_band(h0, unit, diagonal, boundary, |h| {
+            let (_, sites, labels, _) = place(h, data);
+            (sites, labels)
+        })?;
+        (h, Some(trials))
+    } else {
+        (h0, None)
+    };
+    let (solid, sites, labels, (triplets, rims)) = place(h, data);
+    data.occupancy = solid.inside(&data.points);
     for (i, (p, n)) in data.surface.iter_mut().zip(&data.normals).enumerate() {
         let side = if i % 2 == 0 { h } else { -h };
         *p = [0, 1, 2].map(|c| p[c] + side * n[c]);
@@ -347,8 +386,81 @@ pub(crate) fn choose<'a>(
         interior_surface_share: None,
         interior_surface_samples_dropped: 0,
         cap_samples: 0,
+        thickness_search,
     };
     Ok((Target::Shell(solid, sites, labels), report))
+}
+
+/// Half-thicknesses tried below the default h0 = √(A/K), thinnest first, as shares of h0.
+///
+/// The band's sides are exact on a flat part whatever its thickness, and a thinner band
+/// lies closer to the sheet: on libigl's flat `grid.off` at K = 8,192, half the default
+/// (0.39% of the diagonal) took Chamfer from 0.79% to 0.40% and normal consistency from
+/// 0.979 to 0.989. But where the sheet curves, the cells of neighbouring triplets meet in
+/// steps about s²κ/2 high (spacing s, curvature κ), and a band thinner than its steps
+/// breaks into holes: at 0.25% of the diagonal the lilium came out of genus 260 and the
+/// beetle's body of genus 206 (from 0 and 10). So each band's crust is checked.
+pub const BAND_FACTORS: [f64; 4] = [0.3, 0.4, 0.5, 0.7];
+
+/// The thinnest band of [`BAND_FACTORS`]·`h0` whose crust (of the sites `place` puts for
+/// it, as constructed) has the same components and genus as the default band's, and a
+/// certified Hausdorff distance to `unit` no larger: a thinner band only where the sites
+/// carry it without a hole. Returns the half-thickness and every band tried (the default's
+/// first).
+///
+/// # Errors
+/// [`FitError::Failure`] when a crust or its distance cannot be computed.
+fn thinnest_band(
+    h0: f64,
+    unit: &TriMesh,
+    diagonal: f64,
+    boundary_count: usize,
+    mut place: impl FnMut(f64) -> (Vec<[f64; 3]>, Vec<bool>),
+) -> Result<(f64, Vec<BandTrial>), FitError> {
+    let mut trial = |factor: f64| -> Result<BandTrial, FitError> {
+        let (mut sites, mut labels) = place(factor * h0);
+        // The fixed outside sites on the cube's faces, as training adds them: without them
+        // the outer cells are unbounded.
+        let boundary = soft_voronoi::init::boundary_sites(boundary_count);
+        labels.extend(std::iter::repeat(false).take(boundary.len()));
+        sites.extend(boundary);
+        // Welded by position as it would be written (the extracted crust may split a
+        // vertex where Voronoi vertices coincide, which its own genus counts).
+        let crust = crate::crust_step::crust_of(&sites, &labels, FrameMap::Identity, Precision::F64)?;
+        let (report, mesh) = (&crust.check().report, &crust.written.mesh);
+        let opts = metrics::hausdorff::CertifiedOptions { rel_tolerance: 1e-4, ..Default::default() };
+        let hausdorff = if mesh.triangles.is_empty() {
+            f64::INFINITY
+        } else {
+            metrics::hausdorff::hausdorff_certified(unit, mesh, &opts)
+                .map_err(|e| FitError::Failure(format!("distance of a thin shell's crust: {e}")))?
+                .hi
+        };
+        Ok(BandTrial {
+            factor,
+            half_thickness_of_diagonal: factor * h0 / diagonal,
+            components: report.num_components,
+            genus: report.genus,
+            hausdorff_of_diagonal: hausdorff / diagonal,
+            kept: false,
+        })
+    };
+    let mut trials = vec![trial(1.0)?];
+    let mut kept = 0;
+    for factor in BAND_FACTORS {
+        let t = trial(factor)?;
+        let reference = &trials[0];
+        let holds = t.components == reference.components
+            && t.genus == reference.genus
+            && t.hausdorff_of_diagonal <= reference.hausdorff_of_diagonal;
+        trials.push(t);
+        if holds {
+            kept = trials.len() - 1;
+            break;
+        }
+    }
+    trials[kept].kept = true;
+    Ok((trials[kept].factor * h0, trials))
 }
 
 /// Initial sites for the shell of half-thickness h around `unit`: at Poisson-disk points p
@@ -421,11 +533,13 @@ fn shell_sites(
     }
     let mut labels = solid.inside(&sites);
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 5);
+    let filled = sites.len();
     while sites.len() < k {
         let i = (rng.next_u64() % data.points.len() as u64) as usize;
         sites.push(data.points[i]);
-        labels.push(data.occupancy[i]);
     }
+    // Labelled by this band (the pool's labels may be another solid's).
+    labels.extend(solid.inside(&sites[filled..]));
     (sites, labels, (chosen.len(), rim_points.len()))
 }
 
@@ -544,4 +658,69 @@ fn rim_with_frames(mesh: &TriMesh, rim: &[([f64; 3], [f64; 3], u32)]) -> Vec<Rim
             Some((a, b, n, d))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The square [0.3, 0.7]² at z = 0.5 (two triangles).
+    fn square() -> TriMesh {
+        TriMesh {
+            positions: vec![[0.3, 0.3, 0.5], [0.7, 0.3, 0.5], [0.7, 0.7, 0.5], [0.3, 0.7, 0.5]],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+
+    /// Triplets (inside on the square, outside at ±2h) every 0.04 and an outside site 2h
+    /// beyond the rim every 0.02, as `shell_sites` places them; when `puncture`, the middle
+    /// triplet's inside site is labelled outside, a hole through the band.
+    fn band(h: f64, puncture: bool) -> (Vec<[f64; 3]>, Vec<bool>) {
+        let (mut sites, mut labels) = (Vec::new(), Vec::new());
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let (x, y) = (0.3 + 0.02 * i as f64, 0.3 + 0.02 * j as f64);
+                let rim = i == 0 || j == 0 || i == 20 || j == 20;
+                if i % 2 == 0 && j % 2 == 0 || rim {
+                    let middle = i == 10 && j == 10;
+                    sites.extend([[x, y, 0.5], [x, y, 0.5 + 2.0 * h], [x, y, 0.5 - 2.0 * h]]);
+                    labels.extend([!(puncture && middle), false, false]);
+                }
+                if rim {
+                    // Outward across the square's edge (both edges' at a corner).
+                    let out = |k: i32| f64::from(i32::from(k == 20) - i32::from(k == 0));
+                    let d = [out(i), out(j)];
+                    let l = d[0] * d[0] + d[1] * d[1];
+                    sites.push([x + 2.0 * h * d[0] / l.sqrt(), y + 2.0 * h * d[1] / l.sqrt(), 0.5]);
+                    labels.push(false);
+                }
+            }
+        }
+        (sites, labels)
+    }
+
+    #[test]
+    fn the_thinnest_band_that_keeps_the_topology_is_taken() {
+        let unit = square();
+        let (h0, diagonal) = (0.02, unit.diagonal());
+        // Whole at every thickness: the thinnest is taken at once.
+        let (h, trials) = thinnest_band(h0, &unit, diagonal, 32, |h| band(h, false)).unwrap();
+        assert_eq!(h, BAND_FACTORS[0] * h0, "{trials:?}");
+        assert_eq!(trials.len(), 2);
+        assert_eq!((trials[0].components, trials[0].genus), (1, Some(0)), "{trials:?}");
+        assert!(trials[1].kept && !trials[0].kept);
+        assert!(trials[1].hausdorff_of_diagonal < trials[0].hausdorff_of_diagonal, "{trials:?}");
+        // Bands thinner than half the default break (a hole through the middle): the first
+        // whole one is taken, and the broken ones are listed with their genus.
+        let (h, trials) = thinnest_band(h0, &unit, diagonal, 32, |h| band(h, h < 0.45 * h0)).unwrap();
+        assert_eq!(h, 0.5 * h0, "{trials:?}");
+        let genus: Vec<Option<i64>> = trials.iter().map(|t| t.genus).collect();
+        assert_eq!(genus, [Some(0), Some(1), Some(1), Some(0)], "{trials:?}");
+        assert_eq!(trials.iter().filter(|t| t.kept).count(), 1);
+        // Broken at every thinner band: the default stays.
+        let (h, trials) = thinnest_band(h0, &unit, diagonal, 32, |h| band(h, h < h0)).unwrap();
+        assert_eq!(h, h0);
+        assert_eq!(trials.len(), 1 + BAND_FACTORS.len());
+        assert!(trials[0].kept);
+    }
 }

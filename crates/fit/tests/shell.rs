@@ -54,6 +54,15 @@ fn a_flat_sheet_fits_a_thin_shell() {
     assert!(out.report.quality.misclassification < 0.02, "{}", out.report.quality.misclassification);
     assert!(out.report.summary().contains("thin shell"), "{}", out.report.summary());
     assert_eq!(out.report.settings.train.steps, 0, "kept as constructed");
+    // Flat: the thinnest band tried holds, and is the one fitted.
+    let trials = s.thickness_search.as_ref().expect("the default thickness searches");
+    assert_eq!(trials[0].factor, 1.0);
+    let kept: Vec<_> = trials.iter().filter(|t| t.kept).collect();
+    assert_eq!(kept.len(), 1, "{trials:?}");
+    assert_eq!(kept[0].factor, fit::target::BAND_FACTORS[0], "{trials:?}");
+    assert_eq!(kept[0].genus, trials[0].genus);
+    assert!((kept[0].half_thickness_of_diagonal - s.half_thickness_of_diagonal.unwrap()).abs() < 1e-12);
+    assert!(out.report.summary().contains("thinnest"), "{}", out.report.summary());
     // Asked to train, it trains (and stays a closed slab).
     let mut c = small("sheet");
     c.train_shell = true;
