@@ -107,6 +107,7 @@ fn open_patches_and_closed_meshes_get_the_right_solid() {
     };
     let out = fit::fit(&holed, &small("holed"), &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding, "{}", out.report.solid.near_surface_ambiguous_share);
+    assert!(!out.report.summary().contains("--solid shell"), "a small hole's cap is no hint: {}", out.report.summary());
     let out = fit::fit(&sphere, &small("sphere"), &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding);
     assert!(out.report.solid.near_surface_inside_share > 0.3);
@@ -191,4 +192,47 @@ fn a_shell_with_fewer_sites_than_a_rim_quadruplet_still_fits() {
     let mut c = small("tiny");
     c.train.num_sites = 2;
     let _ = fit::fit(&sheet(8), &c, &mut NoProgress);
+}
+
+/// An open pipe is an open mesh around a volume for the automatic rule (its winding number
+/// is 0.7–1 inside), so it keeps the winding solid, whose caps over the pipe's ends lie far
+/// from it: the summary says so and names `--solid shell`, which fits the pipe's wall.
+#[test]
+fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
+    let (nu, nv) = (48u32, 12u32);
+    let mut positions = Vec::new();
+    for i in 0..nu {
+        let a = std::f64::consts::TAU * i as f64 / nu as f64;
+        for j in 0..=nv {
+            positions.push([a.cos(), a.sin(), 2.0 * j as f64 / nv as f64]);
+        }
+    }
+    let id = |i: u32, j: u32| (i % nu) * (nv + 1) + j;
+    let mut triangles = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let pipe = TriMesh { positions, triangles };
+    let out = fit::fit(&pipe, &small("pipe"), &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.rule, SolidRule::Winding);
+    assert!(out.report.solid.cap_samples > 0);
+    let summary = out.report.summary();
+    assert!(summary.contains("--solid shell fits a thin shell"), "{summary}");
+    let mut c = small("pipe");
+    c.sampling.solid = SolidRule::Shell;
+    let shell = fit::fit(&pipe, &c, &mut NoProgress).unwrap();
+    let crust = &shell.report.crust;
+    assert!(crust.is_closed && crust.is_manifold && crust.num_components == 1, "{crust:?}");
+    // Far closer to the pipe than the volume's caps (at this small K the band is not yet a
+    // clean ring: genus 3 here, 1 at K = 8,192).
+    let hausdorff = |r: &fit::FitReport| match &r.metrics {
+        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / m.reference_diagonal,
+        other => panic!("no metrics: {other:?}"),
+    };
+    let (volume, wall) = (hausdorff(&out.report), hausdorff(&shell.report));
+    assert!(volume > 0.2 && wall < 0.5 * volume, "Hausdorff as a volume {volume}, as a shell {wall}");
+    assert!(!shell.report.summary().contains("--solid shell fits"));
 }
