@@ -100,6 +100,9 @@ pub struct BandTrial {
     /// Whether this band was kept (the default's own row is kept when no thinner one
     /// passed).
     pub kept: bool,
+    /// Why this band's crust could not be made or measured (then it is not kept).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
 }
 
 /// Surface samples probed first to decide whether the pool has interior surface at all.
@@ -443,12 +446,29 @@ fn thinnest_band(
             genus: report.genus,
             hausdorff_of_diagonal: hausdorff / diagonal,
             kept: false,
+            error: None,
         })
     };
     let mut trials = vec![trial(1.0)?];
     let mut kept = 0;
     for factor in BAND_FACTORS {
-        let t = trial(factor)?;
+        // A thinner band whose crust cannot be made or measured is not taken, and the fit
+        // goes on: the search must never fail a fit the default band would finish.
+        let t = match trial(factor) {
+            Ok(t) => t,
+            Err(e) => {
+                trials.push(BandTrial {
+                    factor,
+                    half_thickness_of_diagonal: factor * h0 / diagonal,
+                    components: 0,
+                    genus: None,
+                    hausdorff_of_diagonal: f64::INFINITY,
+                    kept: false,
+                    error: Some(e.to_string()),
+                });
+                continue;
+            }
+        };
         let reference = &trials[0];
         let holds = t.components == reference.components
             && t.genus == reference.genus
