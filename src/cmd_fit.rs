@@ -140,7 +140,7 @@ pub struct Args {
     #[arg(long)]
     pub no_prune: bool,
     /// Steps of the surface polish after training (VoroMesh's bisector loss pulls the
-    /// diagram's faces onto surface samples; default 600, 0 or --no-polish: none; off with
+    /// diagram's faces onto surface samples; default 400, 600 above K = 4,096; 0 or --no-polish: none; off with
     /// --preset paper unless given).
     #[arg(long)]
     pub polish_steps: Option<usize>,

@@ -37,6 +37,23 @@ use crate::error::TrainError;
 /// Samples per parallel chunk (fixed, so the sums do not depend on the thread count).
 const CHUNK: usize = 1024;
 
+/// Above this many trainable sites the polish runs 600 steps instead of VoroMesh's 400.
+///
+/// Each step pulls 20,000 surface samples, so over 400 steps a site is pulled by about
+/// 3,900 samples at K = 2,048 but 980 at 8,192: the larger K, the further from converged
+/// the polish stops. Measured on the 16 meshes of `benches/quality.py` (2026-12-04, H %
+/// Hausdorff, Chamfer, normal consistency; the open sheet, a thin shell, is not polished):
+/// - K = 8,192, 400 → 600 steps: Chamfer and normal consistency better on all 15, the
+///   Hausdorff distance on 10 (featuretype 0.71 → 0.50%, thin plate 0.47 → 0.25%), worse
+///   on the Menger sponge (2.47 → 2.89%; over seeds 0–2 2.67 → 2.80% on average),
+///   snowden, npm_teapot and box_fin; 800 steps went further on some and back on others;
+/// - K = 32,768 (spot, featuretype, dragon, bunny_scan): Chamfer and normal consistency
+///   better on all 4, Hausdorff better on spot and featuretype (0.196 → 0.166%, 0.278 →
+///   0.215%), worse on the dragon (2.869 → 2.895%);
+/// - K = 2,048: Chamfer better on 14, but the Hausdorff distance worse on 9 (the Menger
+///   sponge 6.31 → 7.70%), so small K keeps 400.
+pub const POLISH_STEPS_ABOVE: usize = 4096;
+
 /// Settings of the polish.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PolishConfig {
@@ -56,24 +73,16 @@ pub struct PolishConfig {
 }
 
 impl PolishConfig {
-    /// The default for `num_sites` trainable sites: 600 steps of 20,000 samples, 10
-    /// neighbours, lr 1e-3 at K = 8,192 scaled with the surface spacing √(8192/K).
-    ///
-    /// 600 steps, not VoroMesh's 400, measured on the 16 meshes of `benches/quality.py` at
-    /// K = 8,192 (2026-12-04): Chamfer distance and normal consistency better on all 15
-    /// fitted by the polish (spot 0.0076 → 0.0066%, thin plate 0.00087 → 0.00018%; normal
-    /// consistency up by 0.0007–0.0033), the Hausdorff distance better on 10 and worse on
-    /// the Menger sponge (2.47 → 2.89%), snowden, npm_teapot and box_fin; over seeds 0–2
-    /// featuretype's Hausdorff distance averages 0.65% against 0.70% and the sponge's 2.80%
-    /// against 2.67%. 800 steps gained a little more on some meshes and lost on others
-    /// (spot, thin plate, snowden), for 2 s more; 250 lost 16–110% of Chamfer distance.
+    /// The default for `num_sites` trainable sites: 400 steps of 20,000 samples up to K =
+    /// 4,096 and 600 above ([`POLISH_STEPS_ABOVE`]), 10 neighbours, lr 1e-3 at K = 8,192
+    /// scaled with the surface spacing √(8192/K).
     ///
     /// The rate was measured on spot and featuretype from the trained default: 1e-3 gave
     /// spot Chamfer 0.0093% and normal consistency 0.988 against 0.0121% / 0.987 at the
     /// paper's 2.5e-3 (its 5e-3 in [−1, 1]³) and 0.0179% / 0.986 at 5e-3.
     pub fn default_for(num_sites: usize, seed: u64) -> Self {
         PolishConfig {
-            steps: 600,
+            steps: if num_sites > POLISH_STEPS_ABOVE { 600 } else { 400 },
             lr: 1e-3 * (8192.0 / num_sites.max(1) as f64).sqrt(),
             batch: 20_000,
             neighbours: 10,
@@ -271,6 +280,14 @@ mod tests {
     /// The gradient against central differences, with the neighbour sets held fixed (as the
     /// gradient is) by keeping the steps far below the gaps between distances.
     #[test]
+    fn the_default_runs_longer_at_large_k() {
+        assert_eq!(PolishConfig::default_for(2048, 0).steps, 400);
+        assert_eq!(PolishConfig::default_for(POLISH_STEPS_ABOVE, 0).steps, 400);
+        assert_eq!(PolishConfig::default_for(POLISH_STEPS_ABOVE + 1, 0).steps, 600);
+        assert_eq!(PolishConfig::default_for(32768, 0).steps, 600);
+    }
+
+    #[test]
     fn gradient_matches_finite_differences() {
         let mut s = 7u64;
         let sites: Vec<[f64; 3]> = (0..40).map(|_| [lcg(&mut s), lcg(&mut s), lcg(&mut s)]).collect();
@@ -329,10 +346,19 @@ mod tests {
 
     #[test]
     fn schedule_and_validation() {
+        // The halvings at the same fractions of the run whatever its length (the paper
+        // code's steps 80, 150, 200 and 250 of 400).
+        let c = PolishConfig::default_for(2048, 0);
+        assert_eq!((c.steps, c.lr_at(0)), (400, 2e-3));
+        assert_eq!(c.lr_at(79), 2e-3);
+        assert_eq!(c.lr_at(80), 1e-3);
+        assert_eq!(c.lr_at(399), 2e-3 / 16.0);
         let c = PolishConfig::default_for(8192, 0);
-        assert_eq!(c.lr_at(0), 1e-3);
-        assert_eq!(c.lr_at(80), 5e-4);
-        assert_eq!(c.lr_at(399), 1e-3 / 16.0);
+        assert_eq!((c.steps, c.lr_at(0)), (600, 1e-3));
+        assert_eq!(c.lr_at(119), 1e-3);
+        assert_eq!(c.lr_at(120), 5e-4);
+        assert_eq!(c.lr_at(225), 2.5e-4);
+        assert_eq!(c.lr_at(599), 1e-3 / 16.0);
         assert!(PolishConfig { lr: f64::NAN, ..c.clone() }.validate().is_err());
         assert!(PolishConfig { batch: 0, ..c.clone() }.validate().is_err());
         assert!(PolishConfig { neighbours: 0, ..c }.validate().is_err());
