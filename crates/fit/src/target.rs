@@ -553,10 +553,29 @@ fn shell_sites(
     }
     let mut labels = solid.inside(&sites);
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 5);
+    // The slots the triplets and rim points leave (a few) get pool points outside the band
+    // and at least 2h from it, labelled outside: they only split empty space. A pool point
+    // inside the band, off the triplets' lines, put a speck in the flat crust of libigl's
+    // grid.off (the one fill site, 0.0015 from the sheet); a point that close outside would
+    // dent it. Points elsewhere (labelled by the band) only if the pool has none so far.
+    let missing = k.saturating_sub(sites.len());
+    let mut far = Vec::with_capacity(missing);
+    let mut tried = 0;
+    while far.len() < missing && tried < 64 * missing.max(1) && !data.points.is_empty() {
+        let batch: Vec<[f64; 3]> =
+            (0..256).map(|_| data.points[(rng.next_u64() % data.points.len() as u64) as usize]).collect();
+        tried += batch.len();
+        for (p, l) in batch.iter().zip(solid.locate(&batch)) {
+            if far.len() < missing && !l.inside && dist(*p, l.closest) >= 2.0 * h && !far.contains(p) {
+                far.push(*p);
+            }
+        }
+    }
+    labels.extend(std::iter::repeat(false).take(far.len()));
+    sites.extend(far);
     let filled = sites.len();
-    while sites.len() < k {
-        let i = (rng.next_u64() % data.points.len() as u64) as usize;
-        sites.push(data.points[i]);
+    while sites.len() < k && !data.points.is_empty() {
+        sites.push(data.points[(rng.next_u64() % data.points.len() as u64) as usize]);
     }
     // Labelled by this band (the pool's labels may be another solid's).
     labels.extend(solid.inside(&sites[filled..]));
@@ -717,6 +736,40 @@ mod tests {
             }
         }
         (sites, labels)
+    }
+
+    /// The slots the triplets and rim points leave are filled outside the band, at least 2h
+    /// from it, whatever the pool holds (here, a pool of points inside the band only but
+    /// for a few far ones).
+    #[test]
+    fn leftover_slots_are_filled_away_from_the_band() {
+        let unit = square();
+        let oracle = MeshOracle::from_mesh(&unit, &occupancy::Config::default()).unwrap();
+        let h = 0.01;
+        let solid = ShellSolid::new(&oracle, &unit, h);
+        let mut rng = ChunkRng::for_chunk(7, Stream::SitesInit, 9);
+        let surface: Vec<[f64; 3]> =
+            (0..4000).map(|_| [0.3 + 0.4 * rng.uniform(), 0.3 + 0.4 * rng.uniform(), 0.5]).collect();
+        let normals = vec![[0.0, 0.0, 1.0]; surface.len()];
+        // Most of the pool inside the band (0.5 ± h/2), a few points far above it.
+        let mut points: Vec<[f64; 3]> = (0..2000)
+            .map(|_| [0.3 + 0.4 * rng.uniform(), 0.3 + 0.4 * rng.uniform(), 0.5 + h * (rng.uniform() - 0.5)])
+            .collect();
+        points.extend((0..20).map(|i| [0.35 + 0.01 * i as f64, 0.5, 0.8]));
+        let occupancy = vec![true; points.len()];
+        let data = TrainingData { points, occupancy, surface: surface.clone(), normals: normals.clone() };
+        let mut filled = 0;
+        for k in 300..310 {
+            let (sites, labels, (triplets, rims)) = shell_sites(&unit, 0.16, &surface, &normals, &solid, k, &data, 0);
+            assert_eq!(sites.len(), k);
+            let placed = 3 * triplets + 4 * rims;
+            filled += k - placed;
+            for (p, &inside) in sites[placed..].iter().zip(&labels[placed..]) {
+                assert!(!inside, "a fill site inside the band: {p:?}");
+                assert!((p[2] - 0.5).abs() >= 3.0 * h - 1e-12, "a fill site {p:?} within 2h of the band");
+            }
+        }
+        assert!(filled > 0, "no K left a slot to fill");
     }
 
     #[test]
