@@ -369,9 +369,13 @@ impl FitReport {
                         let kept = trials.iter().find(|t| t.kept).map_or(1.0, |t| t.factor);
                         let broken = trials.iter().filter(|t| t.factor < kept).count();
                         if kept < 1.0 {
+                            let thinner = match broken {
+                                0 => String::new(),
+                                n => format!("; the {n} thinner one(s) tried did not"),
+                            };
                             format!(
                                 " That is the thinnest band tried whose crust keeps the default band's topology and \
-                                 Hausdorff distance ({kept} of the default √(A/K); {broken} thinner one(s) did not)."
+                                 Hausdorff distance ({kept} of the default √(A/K){thinner})."
                             )
                         } else {
                             format!(
