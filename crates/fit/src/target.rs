@@ -355,8 +355,8 @@ pub(crate) fn choose<'a>(
         (solid, sites, labels, counts)
     };
     let (h, thickness_search) = if s.shell_thickness.is_none() && !config.train_shell {
-        let boundary = config.train.boundary_sites.unwrap_or_else(|| (k as f64).sqrt().ceil() as usize);
-        let (h, trials) = thinnest_band(h0, unit, diagonal, boundary, |h| {
+        let boundary = config.train.boundary_positions();
+        let (h, trials) = thinnest_band(h0, unit, diagonal, &boundary, |h| {
             let (_, sites, labels, _) = place(h, data);
             (sites, labels)
         })?;
@@ -417,16 +417,15 @@ fn thinnest_band(
     h0: f64,
     unit: &TriMesh,
     diagonal: f64,
-    boundary_count: usize,
+    boundary: &[[f64; 3]],
     mut place: impl FnMut(f64) -> (Vec<[f64; 3]>, Vec<bool>),
 ) -> Result<(f64, Vec<BandTrial>), FitError> {
     let mut trial = |factor: f64| -> Result<BandTrial, FitError> {
         let (mut sites, mut labels) = place(factor * h0);
         // The fixed outside sites on the cube's faces, as training adds them: without them
         // the outer cells are unbounded.
-        let boundary = soft_voronoi::init::boundary_sites(boundary_count);
-        labels.extend(std::iter::repeat(false).take(boundary.len()));
-        sites.extend(boundary);
+        labels.extend(std::iter::repeat_n(false, boundary.len()));
+        sites.extend_from_slice(boundary);
         // Welded by position as it would be written (the extracted crust may split a
         // vertex where Voronoi vertices coincide, which its own genus counts).
         let crust = crate::crust_step::crust_of(&sites, &labels, FrameMap::Identity, Precision::F64)?;
@@ -777,7 +776,8 @@ mod tests {
         let unit = square();
         let (h0, diagonal) = (0.02, unit.diagonal());
         // Whole at every thickness: the thinnest is taken at once.
-        let (h, trials) = thinnest_band(h0, &unit, diagonal, 32, |h| band(h, false)).unwrap();
+        let (h, trials) =
+            thinnest_band(h0, &unit, diagonal, &soft_voronoi::init::boundary_sites(32), |h| band(h, false)).unwrap();
         assert_eq!(h, BAND_FACTORS[0] * h0, "{trials:?}");
         assert_eq!(trials.len(), 2);
         assert_eq!((trials[0].components, trials[0].genus), (1, Some(0)), "{trials:?}");
@@ -785,13 +785,16 @@ mod tests {
         assert!(trials[1].hausdorff_of_diagonal < trials[0].hausdorff_of_diagonal, "{trials:?}");
         // Bands thinner than half the default break (a hole through the middle): the first
         // whole one is taken, and the broken ones are listed with their genus.
-        let (h, trials) = thinnest_band(h0, &unit, diagonal, 32, |h| band(h, h < 0.45 * h0)).unwrap();
+        let (h, trials) =
+            thinnest_band(h0, &unit, diagonal, &soft_voronoi::init::boundary_sites(32), |h| band(h, h < 0.45 * h0))
+                .unwrap();
         assert_eq!(h, 0.5 * h0, "{trials:?}");
         let genus: Vec<Option<i64>> = trials.iter().map(|t| t.genus).collect();
         assert_eq!(genus, [Some(0), Some(1), Some(1), Some(0)], "{trials:?}");
         assert_eq!(trials.iter().filter(|t| t.kept).count(), 1);
         // Broken at every thinner band: the default stays.
-        let (h, trials) = thinnest_band(h0, &unit, diagonal, 32, |h| band(h, h < h0)).unwrap();
+        let (h, trials) =
+            thinnest_band(h0, &unit, diagonal, &soft_voronoi::init::boundary_sites(32), |h| band(h, h < h0)).unwrap();
         assert_eq!(h, h0);
         assert_eq!(trials.len(), 1 + BAND_FACTORS.len());
         assert!(trials[0].kept);

@@ -213,8 +213,18 @@ impl TrainConfig {
     /// Number of boundary sites: at least `boundary_sites` (default ⌈√K⌉), rounded up to
     /// a full m×m grid on each of the 6 faces.
     pub fn num_boundary(&self) -> usize {
-        let want = self.boundary_sites.unwrap_or_else(|| (self.num_sites as f64).sqrt().ceil() as usize);
-        crate::init::boundary_grid_size(want).map_or(0, |m| 6 * m * m)
+        crate::init::boundary_grid_size(self.boundary_request()).map_or(0, |m| 6 * m * m)
+    }
+
+    /// The fixed outside sites on the cube's faces that training adds after the K
+    /// trainable ones ([`crate::init::boundary_sites`] of `boundary_sites`, default ⌈√K⌉).
+    pub fn boundary_positions(&self) -> Vec<[f64; 3]> {
+        crate::init::boundary_sites(self.boundary_request())
+    }
+
+    /// The boundary sites asked for: `boundary_sites`, default ⌈√K⌉.
+    fn boundary_request(&self) -> usize {
+        self.boundary_sites.unwrap_or_else(|| (self.num_sites as f64).sqrt().ceil() as usize)
     }
 
     /// Learning rate at 0-based step `t`: cosine from `lr` to `lr_final`.

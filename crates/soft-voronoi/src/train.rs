@@ -5,7 +5,7 @@ use vf_common::rng::{ChunkRng, Stream};
 use crate::config::{Init, TrainConfig};
 pub use crate::data::TrainingData;
 use crate::error::TrainError;
-use crate::init::{boundary_sites, pairs_init, paper_init, project_sites, samples_init, surface_init};
+use crate::init::{pairs_init, paper_init, project_sites, samples_init, surface_init};
 use crate::kernel::{self, Kernel, Scratch, SiteIndex};
 use crate::losses::{self, Located, SiteGraph, Solid};
 
@@ -247,7 +247,7 @@ impl<'a> Trainer<'a> {
         if let Some(i) = sites.iter().position(|p| !p.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))) {
             return Err(TrainError::Data(format!("initial site {i} is not in the unit cube: {:?}", sites[i])));
         }
-        let boundary = boundary_sites(config.boundary_sites.unwrap_or_else(|| (k as f64).sqrt().ceil() as usize));
+        let boundary = config.boundary_positions();
         debug_assert_eq!(boundary.len(), config.num_boundary());
         labels.extend(std::iter::repeat_n(false, boundary.len()));
         sites.extend(boundary);
