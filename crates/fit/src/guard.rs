@@ -38,14 +38,31 @@ pub struct GuardReport {
     /// Crust vertices farther than this beyond the box trigger mirrors (the carving
     /// tolerance), unit-cube lengths.
     pub threshold: f64,
-    /// Mirror sites added, per round.
+    /// Mirror sites added, per round (before carving).
     pub inserted_per_round: Vec<usize>,
+    /// Mirror sites added per round when the guard ran again after carving's kept rounds
+    /// (empty when carving kept none).
+    pub inserted_after_carving: Vec<usize>,
     /// Mirrors that would have left the unit cube (not added).
     pub skipped_outside_cube: usize,
     /// How far the crust reached beyond the box before and after, unit-cube lengths.
     pub beyond_before: f64,
     /// After the last round.
     pub beyond_after: f64,
+}
+
+impl GuardReport {
+    /// Takes in the report of the guard's second pass, after carving.
+    pub fn after_carving(&mut self, again: GuardReport) {
+        self.inserted_after_carving = again.inserted_per_round;
+        self.skipped_outside_cube += again.skipped_outside_cube;
+        self.beyond_after = again.beyond_after;
+    }
+
+    /// Mirror sites added in both passes.
+    pub fn inserted(&self) -> usize {
+        self.inserted_per_round.iter().chain(&self.inserted_after_carving).sum()
+    }
 }
 
 /// Rounds of [`guard`] at most.

@@ -316,8 +316,8 @@ impl FitReport {
                 let pct = |d: f64| 100.0 * d * r.tolerance_of_diagonal / r.tolerance;
                 let missed = |i: usize| pct(r.input_farthest_per_round.get(i).copied().unwrap_or(0.0));
                 format!(
-                    " Then {inserted} sites were inserted in {} round(s) where the crust strayed more than {:.2}% of \
-                     the diagonal from the input (farthest crust vertex {:.3}% → {:.3}%; input point farthest from \
+                    " Then {inserted} sites were inserted in {} round(s) where the crust and the input lay more than \
+                     {:.2}% of the diagonal apart (farthest crust vertex {:.3}% → {:.3}%; input point farthest from \
                      the crust {:.3}% → {:.3}%).",
                     r.inserted_per_round.len(),
                     100.0 * r.tolerance_of_diagonal,
@@ -330,7 +330,7 @@ impl FitReport {
             _ => String::new(),
         };
         let guarded = match &self.guard {
-            Some(g) if g.inserted_per_round.iter().sum::<usize>() > 0 => {
+            Some(g) if g.inserted() > 0 => {
                 // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
                 let of_diag = self
                     .carving
@@ -341,7 +341,7 @@ impl FitReport {
                     " {} outside sites were added as mirror images of inside sites across the input's bounding box, \
                      where their cells ran past it (the crust reached {:.3}% of the diagonal beyond the box, now \
                      {:.3}%{}).",
-                    g.inserted_per_round.iter().sum::<usize>(),
+                    g.inserted(),
                     100.0 * g.beyond_before * of_diag,
                     100.0 * g.beyond_after * of_diag,
                     if g.skipped_outside_cube > 0 {

@@ -131,3 +131,42 @@ fn the_guard_cuts_a_spike_at_the_bounding_box() {
     assert!(labels[n0..].iter().all(|&l| !l) && sites[n0..].iter().all(|p| p[2] > hi[2]));
     assert!(farthest(&sites, &labels, &oracle) < 0.5 * (before - hi[2]) + 0.004);
 }
+
+/// The other side: a small box beside the sphere that no site stands near. No crust vertex
+/// is far from the input, but the box's samples are far from the crust; the pairs inserted
+/// at them along the box's normals give it a solid of its own.
+#[test]
+fn pairs_at_input_far_from_the_crust_bring_a_lost_part_back() {
+    let sphere = icosphere(5);
+    let (c, r) = ([0.4, 0.5, 0.5], 0.25);
+    let mut unit = TriMesh {
+        positions: sphere.positions.iter().map(|p| [0, 1, 2].map(|k| c[k] + r * p[k])).collect(),
+        triangles: sphere.triangles.clone(),
+    };
+    let small = mesh_io::shapes::cuboid([0.74, 0.46, 0.46], [0.82, 0.54, 0.54]);
+    let n = unit.positions.len() as u32;
+    unit.positions.extend(&small.positions);
+    unit.triangles.extend(small.triangles.iter().map(|t| t.map(|v| v + n)));
+    let oracle = MeshOracle::from_mesh(&unit, &occupancy::Config::default()).unwrap();
+    let solid = MeshSolid { oracle: &oracle };
+    // The sphere's pairs (the icosphere's vertices lie on it), none at the box.
+    let (mut sites, mut labels) = pairs_with_a_gap(c, r, 3000, 2.0);
+    let before = crust::Crust::extract(&sites, &labels, &crust::CrustConfig::default()).unwrap();
+    assert_eq!(mesh_io::topology::TopologyReport::of(&before.mesh).num_components, 1);
+    let tolerance = 0.004;
+    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 4, 600).unwrap();
+    let input = &report.input_farthest_per_round;
+    let kept = report.inserted_per_round.len();
+    // Before: the box's far corner is 0.12 and more from the sphere's crust.
+    assert!(input[0] > 0.1, "{report:?}");
+    assert!(kept > 0, "{report:?}");
+    assert!(input[kept] < 0.25 * input[0], "{report:?}");
+    // The box's crust stays within a few tolerances of it (its edges are cut by pairs
+    // 2·tolerance apart), the F-score rises, and the box is a second body.
+    assert!(report.farthest_after < 3.0 * tolerance, "{report:?}");
+    let f = &report.fscore_per_round;
+    assert!(f[kept] > f[0], "{report:?}");
+    let after = crust::Crust::extract(&sites, &labels, &crust::CrustConfig::default()).unwrap();
+    assert_eq!(mesh_io::topology::TopologyReport::of(&after.mesh).num_components, 2);
+    assert!(after.mesh.positions.iter().any(|p| p[0] > 0.78), "the box's side at x = 0.82 has crust");
+}
