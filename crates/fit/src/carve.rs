@@ -34,6 +34,9 @@ pub struct CarveReport {
     pub tolerance_of_diagonal: f64,
     /// Sites inserted, per round.
     pub inserted_per_round: Vec<usize>,
+    /// Of those, the sites of pairs at input samples far from the crust (the rest are at
+    /// the feet of crust vertices far from the input), per round.
+    pub inserted_at_input_per_round: Vec<usize>,
     /// Farthest crust vertex from the input before and after, unit-cube lengths.
     pub farthest_before: f64,
     /// After the last kept round.
@@ -138,7 +141,7 @@ pub fn carve(
                 } else {
                     soft_voronoi::solid::unit_normal(mesh, c.triangle as usize)
                 };
-                Stray { distance: d, foot: c.point, direction, triangle: c.triangle }
+                Stray { distance: d, foot: c.point, direction, triangle: c.triangle, at_input: false }
             })
             .collect();
         // An input sample far from the crust is its own foot; its pair lies along the
@@ -148,6 +151,7 @@ pub fn carve(
             foot: samples.points[i],
             direction: samples.normals[i],
             triangle: samples.triangles[i],
+            at_input: true,
         }));
         if round == rounds || stray.is_empty() || budget < 2 || stale {
             break;
@@ -157,6 +161,8 @@ pub fn carve(
         });
         let mut feet: Vec<[f64; 3]> = Vec::new();
         let mut new: Vec<[f64; 3]> = Vec::new();
+        // Whether each of `new` came from an input sample's pair.
+        let mut from_input: Vec<bool> = Vec::new();
         for st in &stray {
             if new.len() + 2 > budget {
                 break;
@@ -175,13 +181,16 @@ pub fn carve(
             feet.push(c);
             let n = st.direction;
             new.extend([1.0, -1.0].map(|s| [0, 1, 2].map(|i| (c[i] + s * tolerance * n[i]).clamp(1e-6, 1.0 - 1e-6))));
+            from_input.extend([st.at_input; 2]);
         }
         // A site nearer the input than half its offset stands by another part of the
         // surface than its foot's: the foot is near an edge or a corner, or across a thin
         // part. Its cell, bounded on that side only by the trained sites, pokes through that
         // face as a new spike, so it is left out and its partner alone cuts the spike (see
         // [`MIN_CLEARANCE`]).
-        let new = clear_of_the_input(oracle, new, tolerance)?;
+        let clear = clearance_mask(oracle, &new, tolerance)?;
+        let at_input = from_input.iter().zip(&clear).filter(|(&a, &c)| a && c).count();
+        let new: Vec<[f64; 3]> = new.into_iter().zip(&clear).filter(|(_, &c)| c).map(|(p, _)| p).collect();
         // Each site is labelled by the solid, whatever it gives: at a thin tip both sites of
         // a pair may land outside (or inside), and two outside sites there are exactly what
         // cuts a spike back. (Keeping only pairs that straddle the surface, as the initial
@@ -195,12 +204,14 @@ pub fn carve(
         }
         budget -= kept;
         report.inserted_per_round.push(kept);
+        report.inserted_at_input_per_round.push(at_input);
     }
     let best = best_state(&states);
     report.farthest_before = states[0].farthest;
     report.farthest_after = states[best].farthest;
     report.undone_rounds = report.inserted_per_round.len() - best;
     report.inserted_per_round.truncate(best);
+    report.inserted_at_input_per_round.truncate(best);
     sites.truncate(states[best].sites);
     labels.truncate(states[best].sites);
     Ok(report)
@@ -224,9 +235,15 @@ pub const MIN_CLEARANCE: f64 = 0.5;
 /// # Errors
 /// [`FitError::Failure`] for a non-finite site.
 pub fn clear_of_the_input(oracle: &MeshOracle, new: Vec<[f64; 3]>, tolerance: f64) -> Result<Vec<[f64; 3]>, FitError> {
-    let closest = oracle.closest_points(&new).map_err(failure)?;
+    let clear = clearance_mask(oracle, &new, tolerance)?;
+    Ok(new.into_iter().zip(&clear).filter(|(_, &c)| c).map(|(p, _)| p).collect())
+}
+
+/// For each of `new`: whether the input is at least [`MIN_CLEARANCE`]·`tolerance` away.
+fn clearance_mask(oracle: &MeshOracle, new: &[[f64; 3]], tolerance: f64) -> Result<Vec<bool>, FitError> {
+    let closest = oracle.closest_points(new).map_err(failure)?;
     let min2 = (MIN_CLEARANCE * tolerance).powi(2);
-    Ok(new.into_iter().zip(&closest).filter(|(_, c)| c.squared_distance >= min2).map(|(p, _)| p).collect())
+    Ok(closest.iter().map(|c| c.squared_distance >= min2).collect())
 }
 
 /// Rounds in a row that do not beat the best state before [`carve`] stops early. Measured
@@ -258,6 +275,8 @@ struct Stray {
     direction: [f64; 3],
     /// The input triangle the foot is on.
     triangle: u32,
+    /// Whether the foot is an input sample far from the crust.
+    at_input: bool,
 }
 
 /// The crust after one round of [`carve`].

@@ -315,9 +315,10 @@ impl FitReport {
             Some(r) if inserted > 0 => {
                 let pct = |d: f64| 100.0 * d * r.tolerance_of_diagonal / r.tolerance;
                 let missed = |i: usize| pct(r.input_farthest_per_round.get(i).copied().unwrap_or(0.0));
+                let at_input: usize = r.inserted_at_input_per_round.iter().sum();
                 format!(
-                    " Then {inserted} sites were inserted in {} round(s) where the crust and the input lay more than \
-                     {:.2}% of the diagonal apart (farthest crust vertex {:.3}% → {:.3}%; input point farthest from \
+                    " Then {inserted} sites ({at_input} at input points far from the crust) were inserted in {} \
+                     round(s) where the crust and the input lay more than {:.2}% of the diagonal apart (farthest crust vertex {:.3}% → {:.3}%; input point farthest from \
                      the crust {:.3}% → {:.3}%).",
                     r.inserted_per_round.len(),
                     100.0 * r.tolerance_of_diagonal,

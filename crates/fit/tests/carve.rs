@@ -55,6 +55,9 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     let inserted: usize = report.inserted_per_round.iter().sum();
     assert_eq!(sites.len(), n0 + inserted);
     assert!(inserted > 0 && inserted % 2 == 0, "{report:?}");
+    // The first round's pairs stand at the spike's feet, not at input samples.
+    assert_eq!(report.inserted_at_input_per_round.len(), report.inserted_per_round.len());
+    assert_eq!(report.inserted_at_input_per_round[0], 0, "{report:?}");
     assert!((report.farthest_before - before).abs() < 1e-12);
     assert!(report.farthest_after < 0.5 * before, "{report:?}");
     assert!((farthest(&sites, &labels, &oracle) - report.farthest_after).abs() < 1e-12);
@@ -161,6 +164,8 @@ fn pairs_at_input_far_from_the_crust_bring_a_lost_part_back() {
     assert!(input[0] > 0.1, "{report:?}");
     assert!(kept > 0, "{report:?}");
     assert!(input[kept] < 0.25 * input[0], "{report:?}");
+    // The first round's pairs all stand at the box's samples: no crust vertex was far.
+    assert_eq!(report.inserted_at_input_per_round[0], report.inserted_per_round[0], "{report:?}");
     // The box's crust stays within a few tolerances of it (its edges are cut by pairs
     // 2·tolerance apart), the F-score rises, and the box is a second body.
     assert!(report.farthest_after < 3.0 * tolerance, "{report:?}");
