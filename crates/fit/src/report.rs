@@ -464,9 +464,9 @@ impl FitReport {
                     .map(|r| format!("{} sites: {:.3}%", r.sites, 100.0 * r.hausdorff_hi_of_diagonal))
                     .collect();
                 format!(
-                    " Accuracy target: Hausdorff ≤ {:.3}% of the diagonal {} with {} sites (budget {}; {}).",
+                    " Accuracy target: Hausdorff ≤ {:.3}% of the diagonal {} {} sites (budget {}; {}).",
                     100.0 * a.goal_hausdorff_of_diagonal,
-                    if a.met { "met" } else { "NOT met" },
+                    if a.met { "met with" } else { "NOT met; the fit written is the closest one, with" },
                     a.sites_used,
                     a.max_sites,
                     steps.join(", ")

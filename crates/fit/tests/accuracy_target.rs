@@ -36,14 +36,42 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
         a.trace
     );
     let last = a.trace.last().unwrap();
-    assert_eq!(a.sites_used, last.sites);
-    assert_eq!(out.report.settings.train.num_sites, last.sites);
+    // The fit returned: the round that met the goal, else the closest one.
+    let closest = a.trace.iter().min_by(|x, y| x.hausdorff_hi_of_diagonal.total_cmp(&y.hausdorff_hi_of_diagonal));
+    let kept = if a.met { last } else { closest.unwrap() };
+    assert_eq!(a.sites_used, kept.sites);
+    assert_eq!(out.report.settings.train.num_sites, kept.sites);
+    let hi = match &out.report.metrics {
+        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / sphere.diagonal(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(hi, kept.hausdorff_hi_of_diagonal);
     assert_eq!(a.met, last.hausdorff_hi_of_diagonal <= goal.hausdorff_of_diagonal);
     assert!(a.met || last.sites * 2 > goal.max_sites, "stopped early without meeting the goal");
     assert!(out.report.crust.is_closed && out.report.crust.is_manifold);
     assert!(out.report.summary().contains("Accuracy target"));
     let json = serde_json::to_value(&out.report).unwrap();
     assert!(json["accuracy_target"]["trace"].as_array().unwrap().len() == a.trace.len());
+}
+
+#[test]
+fn an_unreachable_goal_returns_the_closest_fit() {
+    let sphere = icosphere(3);
+    let goal = AccuracyGoal { hausdorff_of_diagonal: 1e-6, max_sites: 512 };
+    let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
+    let a = out.report.accuracy_target.as_ref().expect("the trace");
+    assert!(!a.met);
+    assert_eq!(a.trace.iter().map(|r| r.sites).collect::<Vec<_>>(), vec![128, 256, 512]);
+    let closest = a.trace.iter().min_by(|x, y| x.hausdorff_hi_of_diagonal.total_cmp(&y.hausdorff_hi_of_diagonal));
+    let closest = closest.unwrap();
+    assert_eq!(a.sites_used, closest.sites);
+    assert_eq!(out.report.settings.train.num_sites, closest.sites);
+    let hi = match &out.report.metrics {
+        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / sphere.diagonal(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(hi, closest.hausdorff_hi_of_diagonal);
+    assert!(out.report.summary().contains("NOT met; the fit written is the closest one"));
 }
 
 #[test]
