@@ -388,6 +388,7 @@ fn distances_to(points: &[[f64; 3]], target: &metrics::DistanceMesh) -> Vec<f64>
 /// Samples of the input for [`InputSamples`].
 const INPUT_SAMPLES: usize = 100_000;
 
+/// A failed query while carving, as the fit's error.
 fn failure(e: impl std::fmt::Display) -> FitError {
     FitError::Failure(format!("carving: {e}"))
 }

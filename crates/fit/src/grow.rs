@@ -124,35 +124,31 @@ pub fn fit_to_accuracy(
         });
         let met = hi <= g;
         let next = 2 * cfg.train.num_sites;
-        let k = cfg.train.num_sites;
         // The fit returned when the goal is not met is the closest one, not the last:
         // doubling K need not lower the Hausdorff distance (the bundled bunny at a goal of
-        // 0.15%: 0.220, 0.158 and 0.258% at 8,192, 16,384 and 32,768 sites).
-        let (keep, refine_from) = match best.take() {
-            Some((b_hi, b_k, b_out)) if b_hi <= hi && !met => ((b_hi, b_k, b_out), out.crust.clone()),
-            _ => {
-                let crust = out.crust.clone();
-                ((hi, k, out), crust)
-            }
-        };
+        // 0.15%: 0.220, 0.158 and 0.258% at 8,192, 16,384 and 32,768 sites). A fit that
+        // meets the goal is always the closest so far.
+        let previous = out.crust.clone();
+        if best.as_ref().is_none_or(|b| hi < b.0) {
+            best = Some((hi, cfg.train.num_sites, out));
+        }
         if met || next > goal.max_sites {
-            let (_, k_used, mut out) = keep;
+            let (_, sites_used, mut out) = best.expect("set above");
             out.report.accuracy_target = Some(AccuracyReport {
                 goal_hausdorff_of_diagonal: g,
                 max_sites: goal.max_sites,
                 met,
-                sites_used: k_used,
+                sites_used,
                 trace,
             });
             return Ok(out);
         }
-        best = Some(keep);
         // Twice the sites: the learning rate follows the default's K^−1/2 scaling.
         let shrink = (cfg.train.num_sites as f64 / next as f64).sqrt();
         cfg.train.num_sites = next;
         cfg.train.lr *= shrink;
         cfg.train.lr_final *= shrink;
-        cfg.refine = Some(Refine { previous: refine_from, tolerance: g * diagonal });
+        cfg.refine = Some(Refine { previous, tolerance: g * diagonal });
     }
 }
 

@@ -318,8 +318,8 @@ impl FitReport {
                 let at_input: usize = r.inserted_at_input_per_round.iter().sum();
                 format!(
                     " Then {inserted} sites ({at_input} at input points far from the crust) were inserted in {} \
-                     round(s) where the crust and the input lay more than {:.2}% of the diagonal apart (farthest crust vertex {:.3}% → {:.3}%; input point farthest from \
-                     the crust {:.3}% → {:.3}%).",
+                     round(s) where the crust and the input lay more than {:.2}% of the diagonal apart (farthest \
+                     crust vertex {:.3}% → {:.3}%; input point farthest from the crust {:.3}% → {:.3}%).",
                     r.inserted_per_round.len(),
                     100.0 * r.tolerance_of_diagonal,
                     pct(r.farthest_before),

@@ -5,6 +5,20 @@
 use fit::{fit_to_accuracy, AccuracyGoal, FitConfig, FitError, NoProgress};
 use mesh_io::shapes::icosphere;
 
+/// The certified Hausdorff distance of `out`'s crust to `mesh`, upper end, share of the
+/// diagonal.
+fn hausdorff_of(out: &fit::FitOutput, mesh: &mesh_io::TriMesh) -> f64 {
+    match &out.report.metrics {
+        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / mesh.diagonal(),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// The trace's row with the least Hausdorff distance.
+fn closest(trace: &[fit::grow::GrowthRow]) -> &fit::grow::GrowthRow {
+    trace.iter().min_by(|x, y| x.hausdorff_hi_of_diagonal.total_cmp(&y.hausdorff_hi_of_diagonal)).unwrap()
+}
+
 fn small(k: usize) -> FitConfig {
     let mut c = FitConfig::new("sphere", k);
     c.train.steps = 60;
@@ -19,10 +33,7 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
     let sphere = icosphere(3);
     // A goal the first round misses (128 sites on a sphere: a few % of the diagonal).
     let first = fit::fit(&sphere, &small(128), &mut NoProgress).unwrap();
-    let h0 = match &first.report.metrics {
-        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / sphere.diagonal(),
-        other => panic!("{other:?}"),
-    };
+    let h0 = hausdorff_of(&first, &sphere);
     let goal = AccuracyGoal { hausdorff_of_diagonal: 0.5 * h0, max_sites: 2048 };
     let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
     let a = out.report.accuracy_target.as_ref().expect("the trace");
@@ -37,15 +48,10 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
     );
     let last = a.trace.last().unwrap();
     // The fit returned: the round that met the goal, else the closest one.
-    let closest = a.trace.iter().min_by(|x, y| x.hausdorff_hi_of_diagonal.total_cmp(&y.hausdorff_hi_of_diagonal));
-    let kept = if a.met { last } else { closest.unwrap() };
+    let kept = if a.met { last } else { closest(&a.trace) };
     assert_eq!(a.sites_used, kept.sites);
     assert_eq!(out.report.settings.train.num_sites, kept.sites);
-    let hi = match &out.report.metrics {
-        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / sphere.diagonal(),
-        other => panic!("{other:?}"),
-    };
-    assert_eq!(hi, kept.hausdorff_hi_of_diagonal);
+    assert_eq!(hausdorff_of(&out, &sphere), kept.hausdorff_hi_of_diagonal);
     assert_eq!(a.met, last.hausdorff_hi_of_diagonal <= goal.hausdorff_of_diagonal);
     assert!(a.met || last.sites * 2 > goal.max_sites, "stopped early without meeting the goal");
     assert!(out.report.crust.is_closed && out.report.crust.is_manifold);
@@ -62,15 +68,10 @@ fn an_unreachable_goal_returns_the_closest_fit() {
     let a = out.report.accuracy_target.as_ref().expect("the trace");
     assert!(!a.met);
     assert_eq!(a.trace.iter().map(|r| r.sites).collect::<Vec<_>>(), vec![128, 256, 512]);
-    let closest = a.trace.iter().min_by(|x, y| x.hausdorff_hi_of_diagonal.total_cmp(&y.hausdorff_hi_of_diagonal));
-    let closest = closest.unwrap();
-    assert_eq!(a.sites_used, closest.sites);
-    assert_eq!(out.report.settings.train.num_sites, closest.sites);
-    let hi = match &out.report.metrics {
-        fit::report::MetricsReport::Done(m) => m.hausdorff.hi / sphere.diagonal(),
-        other => panic!("{other:?}"),
-    };
-    assert_eq!(hi, closest.hausdorff_hi_of_diagonal);
+    let kept = closest(&a.trace);
+    assert_eq!(a.sites_used, kept.sites);
+    assert_eq!(out.report.settings.train.num_sites, kept.sites);
+    assert_eq!(hausdorff_of(&out, &sphere), kept.hausdorff_hi_of_diagonal);
     assert!(out.report.summary().contains("NOT met; the fit written is the closest one"));
 }
 
