@@ -10,8 +10,11 @@
 //! in, a part it lost, a dent), the pair c ± t·n along the input's normal puts a site of
 //! the right label on each side of the surface where the crust has none. Far means
 //! farther than t and within [`WORST_SHARE`] of the worst, so each round works where the
-//! Hausdorff distance is set. A site of a pair that would stand nearer the input than half
-//! its offset (by another face, at an edge) is left out ([`MIN_CLEARANCE`]), and the state
+//! Hausdorff distance is set. A pair by an edge is turned to bisect it ([`aim_at_edges`]);
+//! each inserted site gets its mirror images across the other input faces near it, so that
+//! its cell stops at them too (a thin wall's far face: [`mirror_closure`]); a site of a pair
+//! that would still stand nearer the input than half its offset (at a corner) is left out
+//! ([`MIN_CLEARANCE`]), and the state
 //! kept is the one with the least two-sided Hausdorff distance, so that a dent cut by an
 //! inserted outside site counts too. (A single site at the stray vertex itself was tried
 //! first: its cell, bounded only by the sites of an empty sphere, can be larger than the
@@ -37,6 +40,13 @@ pub struct CarveReport {
     /// Of those, the sites of pairs at input samples far from the crust (the rest are at
     /// the feet of crust vertices far from the input), per round.
     pub inserted_at_input_per_round: Vec<usize>,
+    /// Of those, the mirror images of inserted sites across input faces near them
+    /// ([`mirror_closure`]), per round.
+    pub inserted_as_mirrors_per_round: Vec<usize>,
+    /// Why carving was run again without the mirrors, if it was: the crust with them could
+    /// not be written in the output's precision (the main job then carves again from the
+    /// same sites without them).
+    pub mirrors_dropped: Option<String>,
     /// Farthest crust vertex from the input before and after, unit-cube lengths.
     pub farthest_before: f64,
     /// After the last kept round.
@@ -64,7 +74,8 @@ pub struct CarveReport {
 /// far from the crust (farther than `tolerance` and than [`WORST_SHARE`] of the worst),
 /// labelled by `solid`, for up to `rounds` rounds and at most `max_new` sites in all
 /// (farthest first; feet closer than 2·`tolerance` to an earlier one are skipped), then
-/// keeps the best of the states reached (see [`CarveReport::undone_rounds`]).
+/// keeps the best of the states reached (see [`CarveReport::undone_rounds`]). `mirrors`:
+/// whether the inserted sites get their mirror images ([`mirror_closure`]).
 ///
 /// # Errors
 /// [`FitError::Failure`] when a crust cannot be extracted.
@@ -78,6 +89,7 @@ pub fn carve(
     tolerance: f64,
     rounds: usize,
     max_new: usize,
+    mirrors: bool,
 ) -> Result<CarveReport, FitError> {
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
@@ -93,6 +105,7 @@ pub fn carve(
         metrics::SurfaceOptions { num_samples: F_SAMPLES, seed: 0, fscore_tau_rel: tolerance / mesh.diagonal() };
     let input = metrics::DistanceMesh::with_preset(mesh, "input", BvhPreset::VeryFast).map_err(failure)?;
     let samples = unburied_samples(mesh, solid)?;
+    let sample_index = (!samples.points.is_empty()).then(|| soft_voronoi::SiteIndex::new(&samples.points));
     for round in 0..=rounds {
         let crust = Crust::extract(sites, labels, &CrustConfig::default())
             .map_err(|e| FitError::Failure(format!("crust while carving: {e}")))?;
@@ -163,8 +176,11 @@ pub fn carve(
         let mut new: Vec<[f64; 3]> = Vec::new();
         // Whether each of `new` came from an input sample's pair.
         let mut from_input: Vec<bool> = Vec::new();
+        // A round takes at most ROUND_SHARE of the budget left, so that the rounds after it
+        // can cut what it exposes.
+        let round_budget = ((ROUND_SHARE * budget as f64).ceil() as usize).clamp(2, budget);
         for st in &stray {
-            if new.len() + 2 > budget {
+            if new.len() + 2 > round_budget {
                 break;
             }
             let c = st.foot;
@@ -183,14 +199,20 @@ pub fn carve(
             new.extend([1.0, -1.0].map(|s| [0, 1, 2].map(|i| (c[i] + s * tolerance * n[i]).clamp(1e-6, 1.0 - 1e-6))));
             from_input.extend([st.at_input; 2]);
         }
-        // A site nearer the input than half its offset stands by another part of the
-        // surface than its foot's: the foot is near an edge or a corner, or across a thin
-        // part. Its cell, bounded on that side only by the trained sites, pokes through that
-        // face as a new spike, so it is left out and its partner alone cuts the spike (see
-        // [`MIN_CLEARANCE`]).
+        // A pair at an edge is turned to bisect it ([`aim_at_edges`]). A site still nearer
+        // the input than half its offset stands by another part of the surface than its
+        // foot's: at a corner, or across a thin part. Its cell, bounded on that side only by
+        // the trained sites, pokes through that face as a new spike, so it is left out and
+        // its partner alone cuts the spike (see [`MIN_CLEARANCE`]).
+        aim_at_edges(oracle, mesh, &feet, &mut new, tolerance)?;
         let clear = clearance_mask(oracle, &new, tolerance)?;
         let at_input = from_input.iter().zip(&clear).filter(|(&a, &c)| a && c).count();
-        let new: Vec<[f64; 3]> = new.into_iter().zip(&clear).filter(|(_, &c)| c).map(|(p, _)| p).collect();
+        let mut new: Vec<[f64; 3]> = new.into_iter().zip(&clear).filter(|(_, &c)| c).map(|(p, _)| p).collect();
+        let pairs = new.len();
+        if let Some(index) = sample_index.as_ref().filter(|_| mirrors) {
+            mirror_closure(oracle, solid, &samples, index, &mut new, tolerance, round_budget)?;
+        }
+        let mirrors = new.len() - pairs;
         // Each site is labelled by the solid, whatever it gives: at a thin tip both sites of
         // a pair may land outside (or inside), and two outside sites there are exactly what
         // cuts a spike back. (Keeping only pairs that straddle the surface, as the initial
@@ -202,9 +224,10 @@ pub fn carve(
         if kept == 0 {
             break;
         }
-        budget -= kept;
+        budget = budget.saturating_sub(kept);
         report.inserted_per_round.push(kept);
         report.inserted_at_input_per_round.push(at_input);
+        report.inserted_as_mirrors_per_round.push(mirrors);
     }
     let best = best_state(&states);
     report.farthest_before = states[0].farthest;
@@ -212,6 +235,7 @@ pub fn carve(
     report.undone_rounds = report.inserted_per_round.len() - best;
     report.inserted_per_round.truncate(best);
     report.inserted_at_input_per_round.truncate(best);
+    report.inserted_as_mirrors_per_round.truncate(best);
     sites.truncate(states[best].sites);
     labels.truncate(states[best].sites);
     Ok(report)
@@ -244,6 +268,139 @@ fn clearance_mask(oracle: &MeshOracle, new: &[[f64; 3]], tolerance: f64) -> Resu
     let closest = oracle.closest_points(new).map_err(failure)?;
     let min2 = (MIN_CLEARANCE * tolerance).powi(2);
     Ok(closest.iter().map(|c| c.squared_distance >= min2).collect())
+}
+
+/// Turns each pair of `new` (`new[2i]`, `new[2i + 1]`: `feet[i]` ± t·n) whose site
+/// stands within [`MIN_CLEARANCE`]·t of an input face other than its foot's (a face whose
+/// normal n₂ is more than about 25° from n: the foot is by an edge) to bisect the edge,
+/// along (n + n₂)/|n + n₂|, unless n₂ is nearly opposite n (a thin part, not an edge). At a
+/// right-angled edge both sites then stand 0.71 t from both faces, where the clearance rule
+/// would have dropped one of them and left the other alone: a lone outside site above a
+/// CAD part's convex edge dug a dent 0.014 deep into featuretype (4.6 t), and a lone inside
+/// site at a concave one poked through the thin wall behind it.
+///
+/// # Errors
+/// [`FitError::Failure`] for a non-finite site.
+fn aim_at_edges(
+    oracle: &MeshOracle,
+    mesh: &TriMesh,
+    feet: &[[f64; 3]],
+    new: &mut [[f64; 3]],
+    tolerance: f64,
+) -> Result<(), FitError> {
+    let closest = oracle.closest_points(new).map_err(failure)?;
+    let min2 = (MIN_CLEARANCE * tolerance).powi(2);
+    for (k, &f) in feet.iter().enumerate() {
+        let n = [0, 1, 2].map(|i| (new[2 * k][i] - f[i]) / tolerance);
+        // The first site of the pair by another face, with the bisecting direction.
+        let turned = closest[2 * k..2 * k + 2].iter().find_map(|c| {
+            let n2 = soft_voronoi::solid::unit_normal(mesh, c.triangle as usize);
+            let b = [0, 1, 2].map(|i| n[i] + n2[i]);
+            let len = dot(b, b).sqrt();
+            (c.squared_distance < min2 && dot(n, n2) <= EDGE_COSINE && len >= 0.5).then(|| b.map(|x| x / len))
+        });
+        if let Some(b) = turned {
+            for (j, sign) in [(2 * k, 1.0), (2 * k + 1, -1.0)] {
+                new[j] = [0, 1, 2].map(|i| (f[i] + sign * tolerance * b[i]).clamp(1e-6, 1.0 - 1e-6));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Normals with a cosine above this are one face to [`aim_at_edges`] (about 25°).
+const EDGE_COSINE: f64 = 0.9;
+
+/// Mirror images of the inserted sites across the input faces near them, and of those in
+/// turn, [`CLOSURE_DEPTH`] times: for each site s of `new` and each input face within
+/// [`CLOSURE_REACH`]·t of it (the nearest sample of each group of samples whose normals
+/// agree within [`FACE_COSINE`]; q, n), the site s − 2((s − q)·n)n of the other label
+/// (the solid is asked; a mirror it labels otherwise, within 0.3 t of a site already there,
+/// or nearer the input than [`MIN_CLEARANCE`]·t, like an inserted site, is not added; nor
+/// one across a face whose plane passes that near s). Each such face is then the bisector of s and its mirror near q,
+/// so the cell of s cannot cross it there. A pair's own partner is its mirror across its
+/// foot's face; the others are what it lacks: a pair's inside site in a wall thinner than
+/// the trained sites' spacing (featuretype's counterbores come within 1.8 t of the outer
+/// face) poked out through the wall's far face as a spike 0.02 long (6 t), and a pair
+/// turned to bisect an edge poked through both faces of the edge. Measured on featuretype
+/// at K = 8,192, seeds 0 / 1 / 2: certified Hausdorff 0.498 / 0.84 / 0.58% of the
+/// diagonal without the mirrors and the turning, 0.328 / 0.376 / 0.386% with both.
+/// Appends to `new` until it holds `budget` sites.
+fn mirror_closure(
+    oracle: &MeshOracle,
+    solid: &dyn Solid,
+    samples: &InputSamples,
+    index: &soft_voronoi::SiteIndex,
+    new: &mut Vec<[f64; 3]>,
+    tolerance: f64,
+    budget: usize,
+) -> Result<(), FitError> {
+    let reach = CLOSURE_REACH * tolerance;
+    let dup2 = (0.3 * tolerance).powi(2);
+    let mut level: Vec<([f64; 3], bool)> = new.iter().copied().zip(solid.inside(new)).collect();
+    let mut near = Vec::new();
+    for _ in 0..CLOSURE_DEPTH {
+        let mut candidates: Vec<([f64; 3], bool)> = Vec::new();
+        for &(s, label) in &level {
+            index.candidates(&samples.points, s, reach, &mut near);
+            near.retain(|&(_, d)| d < reach);
+            near.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+            let mut faces: Vec<[f64; 3]> = Vec::new();
+            for &(i, _) in &near {
+                let (q, n) = (samples.points[i as usize], samples.normals[i as usize]);
+                if faces.iter().any(|m| dot(*m, n) > FACE_COSINE) {
+                    continue;
+                }
+                faces.push(n);
+                let h = dot([0, 1, 2].map(|k| s[k] - q[k]), n);
+                if h.abs() < MIN_CLEARANCE * tolerance || h.abs() > reach {
+                    continue;
+                }
+                candidates.push(([0, 1, 2].map(|k| (s[k] - 2.0 * h * n[k]).clamp(1e-6, 1.0 - 1e-6)), !label));
+            }
+        }
+        let points: Vec<[f64; 3]> = candidates.iter().map(|c| c.0).collect();
+        let clear = clearance_mask(oracle, &points, tolerance)?;
+        let mut next: Vec<([f64; 3], bool)> = Vec::new();
+        for ((c, inside), clear) in candidates.into_iter().zip(solid.inside(&points)).zip(clear) {
+            if c.1 != inside
+                || !clear
+                || new.len() + next.len() >= budget
+                || new.iter().chain(next.iter().map(|n| &n.0)).any(|x| dist2(*x, c.0) < dup2)
+            {
+                continue;
+            }
+            next.push(c);
+        }
+        if next.is_empty() {
+            break;
+        }
+        new.extend(next.iter().map(|n| n.0));
+        level = next;
+    }
+    Ok(())
+}
+
+/// The most of the budget left that one round of [`carve`] inserts. Measured on the Menger
+/// sponge at K = 8,192, where every round has more strays than the budget: with the pairs
+/// turned at edges and mirrored ([`aim_at_edges`], [`mirror_closure`]) and the mirrors not
+/// yet held to the budget, the first round took 1,373 sites and left the next rounds
+/// nothing: 2.61% of the diagonal against 1.99% before them; at half, eight rounds ran and
+/// it came out at 1.90%.
+pub const ROUND_SHARE: f64 = 0.5;
+
+/// How far from an inserted site (in tolerances) [`mirror_closure`] looks for faces.
+pub const CLOSURE_REACH: f64 = 3.0;
+
+/// Rounds of mirroring in [`mirror_closure`] (a mirror of a mirror closes a thin wall's
+/// far side).
+pub const CLOSURE_DEPTH: usize = 3;
+
+/// Sample normals with a cosine above this are one face to [`mirror_closure`] (about 18°).
+const FACE_COSINE: f64 = 0.95;
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Rounds in a row that do not beat the best state before [`carve`] stops early. Measured
@@ -419,6 +576,60 @@ fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
 mod tests {
     use super::*;
     use mesh_io::shapes::cuboid;
+
+    /// The mirror closure of `pair` (outside site first) at the centre of a square plate
+    /// `w` thick (top face at z = 0.5 + w), tolerance `t`.
+    fn closure_on_a_plate(w: f64, t: f64, pair: [[f64; 3]; 2]) -> Vec<[f64; 3]> {
+        let plate = cuboid([0.3, 0.3, 0.5], [0.7, 0.7, 0.5 + w]);
+        let oracle = MeshOracle::from_mesh(&plate, &occupancy::Config::default()).unwrap();
+        let solid = soft_voronoi::MeshSolid { oracle: &oracle };
+        let samples = unburied_samples(&plate, &solid).unwrap();
+        let index = soft_voronoi::SiteIndex::new(&samples.points);
+        let mut new = pair.to_vec();
+        mirror_closure(&oracle, &solid, &samples, &index, &mut new, t, 100).unwrap();
+        new
+    }
+
+    #[test]
+    fn a_pair_in_a_thin_wall_gets_the_mirror_across_its_far_face() {
+        let t = 0.004;
+        // 1.5 t thick: the inside site, t under the top face, is 0.5 t over the bottom one;
+        // its mirror across it (outside, 0.5 t under the plate) is added, and nothing else
+        // (the mirrors across the top face are the pair itself; the others would have the
+        // wrong label).
+        let top = 0.5 + 1.5 * t;
+        let pair = [[0.5, 0.5, top + t], [0.5, 0.5, top - t]];
+        let new = closure_on_a_plate(1.5 * t, t, pair);
+        assert_eq!(new.len(), 3, "{new:?}");
+        assert_eq!(&new[..2], &pair);
+        assert!((0..3).all(|k| (new[2][k] - [0.5, 0.5, 0.5 - 0.5 * t][k]).abs() < 1e-9), "{new:?}");
+        // On a plate 10 t thick no face but the top is within reach: nothing is added.
+        let top = 0.5 + 10.0 * t;
+        let pair = [[0.5, 0.5, top + t], [0.5, 0.5, top - t]];
+        assert_eq!(closure_on_a_plate(10.0 * t, t, pair), pair.to_vec());
+    }
+
+    #[test]
+    fn a_pair_by_an_edge_is_turned_to_bisect_it() {
+        let cube = cuboid([0.3; 3], [0.7; 3]);
+        let oracle = MeshOracle::from_mesh(&cube, &occupancy::Config::default()).unwrap();
+        let t = 0.004;
+        // Feet on the top face: 0.3 t from the edge x = 0.7 (the inside site would stand
+        // 0.3 t from the side face), and in the middle of the face.
+        let feet = [[0.7 - 0.3 * t, 0.5, 0.7], [0.5, 0.5, 0.7]];
+        let mut new: Vec<[f64; 3]> =
+            feet.iter().flat_map(|c| [1.0, -1.0].map(|s| [c[0], c[1], c[2] + s * t])).collect();
+        let straight = new.clone();
+        aim_at_edges(&oracle, &cube, &feet, &mut new, t).unwrap();
+        let h = std::f64::consts::FRAC_1_SQRT_2 * t;
+        let turned = [[feet[0][0] + h, 0.5, 0.7 + h], [feet[0][0] - h, 0.5, 0.7 - h]];
+        for (a, b) in new[..2].iter().zip(&turned) {
+            assert!((0..3).all(|k| (a[k] - b[k]).abs() < 1e-12), "{new:?}");
+        }
+        assert_eq!(new[2..], straight[2..]);
+        // Both sites of the turned pair are now clear of the input.
+        assert!(clearance_mask(&oracle, &new, t).unwrap().iter().all(|&c| c));
+    }
 
     #[test]
     fn the_f_score_slack_grows_with_what_the_crust_misses() {

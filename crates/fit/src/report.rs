@@ -316,16 +316,24 @@ impl FitReport {
                 let pct = |d: f64| 100.0 * d * r.tolerance_of_diagonal / r.tolerance;
                 let missed = |i: usize| pct(r.input_farthest_per_round.get(i).copied().unwrap_or(0.0));
                 let at_input: usize = r.inserted_at_input_per_round.iter().sum();
+                let mirrors: usize = r.inserted_as_mirrors_per_round.iter().sum();
                 format!(
-                    " Then {inserted} sites ({at_input} at input points far from the crust) were inserted in {} \
+                    " Then {inserted} sites ({at_input} at input points far from the crust, {mirrors} mirror images \
+                     across faces near them) were inserted in {} \
                      round(s) where the crust and the input lay more than {:.2}% of the diagonal apart (farthest \
-                     crust vertex {:.3}% → {:.3}%; input point farthest from the crust {:.3}% → {:.3}%).",
+                     crust vertex {:.3}% → {:.3}%; input point farthest from the crust {:.3}% → {:.3}%){}.",
                     r.inserted_per_round.len(),
                     100.0 * r.tolerance_of_diagonal,
                     pct(r.farthest_before),
                     pct(r.farthest_after),
                     missed(0),
-                    missed(r.inserted_per_round.len())
+                    missed(r.inserted_per_round.len()),
+                    if r.mirrors_dropped.is_some() {
+                        "; carving ran a second time without mirror images, as the crust with them could not be \
+                         written in the output's precision (report: carving.mirrors_dropped)"
+                    } else {
+                        ""
+                    }
                 )
             }
             _ => String::new(),

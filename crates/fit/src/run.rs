@@ -177,23 +177,52 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
         None => None,
     };
-    let carving = match carve {
-        Some(c) => {
-            let k = trainer.config().num_sites;
-            let tolerance = c * diagonal;
-            let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, tolerance, 8, k / 8)?;
-            r.tolerance_of_diagonal = c;
-            Some(r)
+    // Carving's mirrors can leave Voronoi features finer than the output's precision holds
+    // (on snowden, a thin-walled shell, at K = 8,192: float32 rounding broke the crust
+    // beyond repair); then carving runs again from the same sites without them.
+    let before_carving = carve.map(|_| (sites.clone(), labels.clone(), guard.clone()));
+    let mut mirrors = true;
+    let mut dropped = None;
+    let (carving, pruning, checked) = loop {
+        let carving = match carve {
+            Some(c) => {
+                let k = trainer.config().num_sites;
+                let tolerance = c * diagonal;
+                let mut r = crate::carve::carve(
+                    &mut sites,
+                    &mut labels,
+                    &oracle,
+                    &p.unit,
+                    solid,
+                    tolerance,
+                    8,
+                    k / 8,
+                    mirrors,
+                )?;
+                r.tolerance_of_diagonal = c;
+                r.mirrors_dropped = dropped.take();
+                Some(r)
+            }
+            None => None,
+        };
+        if let (Some(g), Some((lo, hi, threshold)), Some(r)) = (guard.as_mut(), guard_box, carving.as_ref()) {
+            if !r.inserted_per_round.is_empty() {
+                g.after_carving(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?);
+            }
         }
-        None => None,
+        let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
+        let mirrored = carving.as_ref().is_some_and(|r| r.inserted_as_mirrors_per_round.iter().sum::<usize>() > 0);
+        match crust_of(&sites, &labels, &p.transform, config.output_precision) {
+            Ok(checked) => break (carving, pruning, checked),
+            Err(FitError::Input(e)) if mirrored => {
+                let Some((s, l, g)) = before_carving.clone() else { return Err(FitError::Input(e)) };
+                (sites, labels, guard) = (s, l, g);
+                mirrors = false;
+                dropped = Some(e);
+            }
+            Err(e) => return Err(e),
+        }
     };
-    if let (Some(g), Some((lo, hi, threshold)), Some(r)) = (guard.as_mut(), guard_box, carving.as_ref()) {
-        if !r.inserted_per_round.is_empty() {
-            g.after_carving(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?);
-        }
-    }
-    let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
-    let checked = crust_of(&sites, &labels, &p.transform, config.output_precision)?;
     let crust_mesh = checked.written.mesh.clone();
     timings.crust = lap.next();
 

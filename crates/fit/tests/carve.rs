@@ -51,7 +51,7 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert!(before > 0.02, "the gap makes a spike: {before}");
     let tolerance = 0.004;
     let n0 = sites.len();
-    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 4, 400).unwrap();
+    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 4, 400, true).unwrap();
     let inserted: usize = report.inserted_per_round.iter().sum();
     assert_eq!(sites.len(), n0 + inserted);
     assert!(inserted > 0 && inserted % 2 == 0, "{report:?}");
@@ -157,15 +157,22 @@ fn pairs_at_input_far_from_the_crust_bring_a_lost_part_back() {
     let before = crust::Crust::extract(&sites, &labels, &crust::CrustConfig::default()).unwrap();
     assert_eq!(mesh_io::topology::TopologyReport::of(&before.mesh).num_components, 1);
     let tolerance = 0.004;
-    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 4, 600).unwrap();
+    // The budget covers two rounds over the box: its first round's pairs (turned to bisect
+    // the box's edges, not left out there) and their mirrors take 600 sites.
+    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 4, 900, true).unwrap();
     let input = &report.input_farthest_per_round;
     let kept = report.inserted_per_round.len();
     // Before: the box's far corner is 0.12 and more from the sphere's crust.
     assert!(input[0] > 0.1, "{report:?}");
     assert!(kept > 0, "{report:?}");
     assert!(input[kept] < 0.25 * input[0], "{report:?}");
-    // The first round's pairs all stand at the box's samples: no crust vertex was far.
-    assert_eq!(report.inserted_at_input_per_round[0], report.inserted_per_round[0], "{report:?}");
+    // The first round's pairs all stand at the box's samples (no crust vertex was far), and
+    // the rest are their mirror images across the box's faces near them.
+    assert_eq!(
+        report.inserted_at_input_per_round[0] + report.inserted_as_mirrors_per_round[0],
+        report.inserted_per_round[0],
+        "{report:?}"
+    );
     // The box's crust stays within a few tolerances of it (its edges are cut by pairs
     // 2·tolerance apart), the F-score rises, and the box is a second body.
     assert!(report.farthest_after < 3.0 * tolerance, "{report:?}");
