@@ -293,11 +293,11 @@ fn aim_at_edges(
     for (k, &f) in feet.iter().enumerate() {
         let n = [0, 1, 2].map(|i| (new[2 * k][i] - f[i]) / tolerance);
         // The first site of the pair by another face, with the bisecting direction.
-        let turned = closest[2 * k..2 * k + 2].iter().find_map(|c| {
+        let turned = closest[2 * k..2 * k + 2].iter().filter(|c| c.squared_distance < min2).find_map(|c| {
             let n2 = soft_voronoi::solid::unit_normal(mesh, c.triangle as usize);
             let b = [0, 1, 2].map(|i| n[i] + n2[i]);
             let len = dot(b, b).sqrt();
-            (c.squared_distance < min2 && dot(n, n2) <= EDGE_COSINE && len >= 0.5).then(|| b.map(|x| x / len))
+            (dot(n, n2) <= EDGE_COSINE && len >= 0.5).then(|| b.map(|x| x / len))
         });
         if let Some(b) = turned {
             for (j, sign) in [(2 * k, 1.0), (2 * k + 1, -1.0)] {
@@ -317,8 +317,8 @@ const EDGE_COSINE: f64 = 0.9;
 /// agree within [`FACE_COSINE`]; q, n), the site s − 2((s − q)·n)n of the other label
 /// (the solid is asked; a mirror it labels otherwise, within 0.3 t of a site already there,
 /// or nearer the input than [`MIN_CLEARANCE`]·t, like an inserted site, is not added; nor
-/// one across a face whose plane passes that near s). Each such face is then the bisector of s and its mirror near q,
-/// so the cell of s cannot cross it there. A pair's own partner is its mirror across its
+/// one across a face whose plane passes that near s). Each such face is then the bisector
+/// of s and its mirror near q, so the cell of s cannot cross it there. A pair's own partner is its mirror across its
 /// foot's face; the others are what it lacks: a pair's inside site in a wall thinner than
 /// the trained sites' spacing (featuretype's counterbores come within 1.8 t of the outer
 /// face) poked out through the wall's far face as a spike 0.02 long (6 t), and a pair
@@ -399,6 +399,7 @@ pub const CLOSURE_DEPTH: usize = 3;
 /// Sample normals with a cosine above this are one face to [`mirror_closure`] (about 18°).
 const FACE_COSINE: f64 = 0.95;
 
+/// (`occupancy`'s vector helpers are private to it.)
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
