@@ -147,7 +147,16 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     progress.stage(Stage::Polish);
     let (mut sites, mut labels, num_projected) = trainer.final_sites();
     let polish = match &config.polish {
-        Some(pc) if !target.places_sites() => Some(polish(&mut sites, &data, &trainer, pc, config, progress)?),
+        Some(pc) if !target.places_sites() => {
+            // Cap samples add to each batch instead of taking from the input's share: the
+            // input's faces are pulled as often as without caps (on the benchmark's teapots
+            // and soup, caps that took their share of a fixed batch moved the crust's
+            // Hausdorff distance by 0.01–0.3% of the diagonal).
+            let mut pc = pc.clone();
+            let input = data.surface.len().saturating_sub(solid_report.cap_samples).max(1);
+            pc.batch = pc.batch * data.surface.len() / input;
+            Some(polish(&mut sites, &data, &trainer, &pc, config, progress)?)
+        }
         _ => None,
     };
     timings.polish = lap.next();
