@@ -28,7 +28,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let diagonal = unit.diagonal();
     let (mut sites, mut labels) = (file.sites, file.inside);
     let tolerance = fit::DEFAULT_CARVE * diagonal;
-    let r = fit::carve::carve(&mut sites, &mut labels, &oracle, &unit, &solid, tolerance, 8, k / 8, true)?;
+    let r = fit::carve::carve(
+        &mut sites,
+        &mut labels,
+        &oracle,
+        &unit,
+        &solid,
+        &fit::carve::CarveOptions::for_sites(tolerance, k),
+    )?;
     let pct = |v: &[f64]| v.iter().map(|f| format!("{:.3}", 100.0 * f / diagonal)).collect::<Vec<_>>().join(" ");
     let kept = r.inserted_per_round.len();
     println!("crust vertex farthest from the input, per extraction (%): {}", pct(&r.farthest_per_round));

@@ -69,28 +69,49 @@ pub struct CarveReport {
     pub undone_rounds: usize,
 }
 
+/// How [`carve`] runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CarveOptions {
+    /// How far a crust vertex or an input sample may stray before a pair goes there, in
+    /// the unit frame (the pairs' half-offset too).
+    pub tolerance: f64,
+    /// Rounds at most.
+    pub rounds: usize,
+    /// Sites inserted at most, over all rounds.
+    pub max_new: usize,
+    /// Whether the inserted sites get their mirror images ([`mirror_closure`]).
+    pub mirrors: bool,
+}
+
+impl CarveOptions {
+    /// The main job's: [`ROUNDS`] rounds and K/8 sites for `k` sites, with mirrors.
+    pub fn for_sites(tolerance: f64, k: usize) -> Self {
+        CarveOptions { tolerance, rounds: ROUNDS, max_new: k / 8, mirrors: true }
+    }
+}
+
+/// Rounds of the main job's carving ([`CarveOptions::for_sites`]).
+pub const ROUNDS: usize = 8;
+
 /// Inserts pairs of sites (appended to `sites` and `labels`) at the feet of the crust's
 /// vertices far from `mesh` (the mesh behind `oracle`, same frame) and at the input samples
-/// far from the crust (farther than `tolerance` and than [`WORST_SHARE`] of the worst),
-/// labelled by `solid`, for up to `rounds` rounds and at most `max_new` sites in all
-/// (farthest first; feet closer than 2·`tolerance` to an earlier one are skipped), then
-/// keeps the best of the states reached (see [`CarveReport::undone_rounds`]). `mirrors`:
-/// whether the inserted sites get their mirror images ([`mirror_closure`]).
+/// far from the crust (farther than the tolerance and than [`WORST_SHARE`] of the worst),
+/// labelled by `solid`, for up to `options.rounds` rounds and at most `options.max_new`
+/// sites in all (farthest first; feet closer than two tolerances to an earlier one are
+/// skipped), then keeps the best of the states reached (see
+/// [`CarveReport::undone_rounds`]).
 ///
 /// # Errors
 /// [`FitError::Failure`] when a crust cannot be extracted.
-#[allow(clippy::too_many_arguments)]
 pub fn carve(
     sites: &mut Vec<[f64; 3]>,
     labels: &mut Vec<bool>,
     oracle: &MeshOracle,
     mesh: &TriMesh,
     solid: &dyn Solid,
-    tolerance: f64,
-    rounds: usize,
-    max_new: usize,
-    mirrors: bool,
+    options: &CarveOptions,
 ) -> Result<CarveReport, FitError> {
+    let CarveOptions { tolerance, rounds, max_new, mirrors } = *options;
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
     let open_edges = mesh_io::topology::boundary_edges(mesh);

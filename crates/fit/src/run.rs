@@ -197,17 +197,9 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
             Some(c) => {
                 let k = trainer.config().num_sites;
                 let tolerance = c * diagonal;
-                let mut r = crate::carve::carve(
-                    &mut sites,
-                    &mut labels,
-                    &oracle,
-                    &p.unit,
-                    solid,
-                    tolerance,
-                    8,
-                    k / 8,
-                    mirrors,
-                )?;
+                let options =
+                    crate::carve::CarveOptions { mirrors, ..crate::carve::CarveOptions::for_sites(tolerance, k) };
+                let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, &options)?;
                 r.tolerance_of_diagonal = c;
                 r.mirrors_dropped = dropped.take();
                 Some(r)
