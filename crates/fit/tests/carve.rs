@@ -51,15 +51,8 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert!(before > 0.02, "the gap makes a spike: {before}");
     let tolerance = 0.004;
     let n0 = sites.len();
-    let report = carve(
-        &mut sites,
-        &mut labels,
-        &oracle,
-        &unit,
-        &solid,
-        &CarveOptions { tolerance, rounds: 4, max_new: 400, mirrors: true },
-    )
-    .unwrap();
+    let options = CarveOptions { tolerance, rounds: 4, max_new: 400, mirrors: true };
+    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, &options).unwrap();
     let inserted: usize = report.inserted_per_round.iter().sum();
     assert_eq!(sites.len(), n0 + inserted);
     assert!(inserted > 0 && inserted % 2 == 0, "{report:?}");
@@ -167,15 +160,8 @@ fn pairs_at_input_far_from_the_crust_bring_a_lost_part_back() {
     let tolerance = 0.004;
     // The budget covers two rounds over the box: its first round's pairs (turned to bisect
     // the box's edges, not left out there) and their mirrors take 600 sites.
-    let report = carve(
-        &mut sites,
-        &mut labels,
-        &oracle,
-        &unit,
-        &solid,
-        &CarveOptions { tolerance, rounds: 4, max_new: 900, mirrors: true },
-    )
-    .unwrap();
+    let options = CarveOptions { tolerance, rounds: 4, max_new: 900, mirrors: true };
+    let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, &options).unwrap();
     let input = &report.input_farthest_per_round;
     let kept = report.inserted_per_round.len();
     // Before: the box's far corner is 0.12 and more from the sphere's crust.
