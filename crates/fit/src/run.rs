@@ -148,13 +148,10 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     let (mut sites, mut labels, num_projected) = trainer.final_sites();
     let polish = match &config.polish {
         Some(pc) if !target.places_sites() => {
-            // Cap samples add to each batch instead of taking from the input's share: the
-            // input's faces are pulled as often as without caps (on the benchmark's teapots
-            // and soup, caps that took their share of a fixed batch moved the crust's
-            // Hausdorff distance by 0.01–0.3% of the diagonal).
-            // At most twice the batch, which bounds the polish's time where the caps
-            // outweigh the input (an open pipe's lids); libigl's halftunnel, caps a third
-            // of the crust, takes 1.4 times.
+            // Cap samples add to each batch instead of taking from the input's share, so the
+            // input's faces are pulled as often as without caps; at most twice the batch,
+            // which bounds the polish's time where the caps outweigh the input (an open
+            // pipe's lids; libigl's halftunnel, caps a third of the crust, takes 1.4 times).
             let mut pc = pc.clone();
             let input = data.surface.len().saturating_sub(solid_report.cap_samples).max(1);
             pc.batch = pc.batch * data.surface.len().min(2 * input) / input;

@@ -178,11 +178,10 @@ fn drop_interior_surface(solid: &dyn Solid, data: &mut TrainingData, diagonal: f
 /// point the first step keeps stands for 1 / (2·ρ·min([`CAP_BAND`]/|∇w|, 2e)) of the
 /// level set (ρ: the pool's points per unit volume; the step keeps the points of a slab
 /// that thick, e the probes' offset), so the caps' area is the sum over those points,
-/// shared evenly by the kept points;
-/// each kept point is joined by points uniform in its tangent disk of that area (the cap
-/// is smooth: at the disk's radius, a fraction of a spacing, it leaves the plane by far
-/// less than the carving tolerance). Returns (points, normals, how many of them are the
-/// kept points, which come first), unit frame.
+/// shared evenly by the kept points; each kept point is joined by points uniform in its
+/// tangent disk of that area (the cap is smooth: at the disk's radius, a fraction of a
+/// spacing, it leaves the plane by far less than the carving tolerance). Returns (points,
+/// normals, how many of them are the kept points, which come first), unit frame.
 ///
 /// # Errors
 /// [`FitError::Failure`] when an oracle query fails.
@@ -285,12 +284,11 @@ pub fn cap_samples(
     let extra = ((share / area_per_sample).round() as usize).clamp(1, CAP_MAX_PER_POINT) - 1;
     let disk = (share / std::f64::consts::PI).sqrt();
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 7);
-    let mut uniform01 = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
     let (mut points, mut frames) = (kept.clone(), normals.clone());
     for (p, n) in kept.iter().zip(&normals) {
         let (u, v) = tangents(*n);
         for _ in 0..extra {
-            let (rho, phi) = (disk * uniform01().sqrt(), std::f64::consts::TAU * uniform01());
+            let (rho, phi) = (disk * rng.uniform().sqrt(), std::f64::consts::TAU * rng.uniform());
             let (a, b) = (rho * phi.cos(), rho * phi.sin());
             points.push([0, 1, 2].map(|c| (p[c] + a * u[c] + b * v[c]).clamp(0.0, 1.0)));
             frames.push(*n);
@@ -302,7 +300,8 @@ pub fn cap_samples(
 /// A Newton step's moved point and |∇w| where it started ([`cap_samples`]), if it held.
 type Stepped = Option<([f64; 3], f64)>;
 
-/// Two unit vectors orthogonal to the unit vector `n` and to each other.
+/// Two unit vectors orthogonal to the unit vector `n` and to each other (occupancy's vector
+/// helpers are private to it, as carve.rs notes for its `dot`).
 fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let a = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
     let cross =
