@@ -449,7 +449,8 @@ impl FitReport {
             };
             format!(
                 "{interior} The solid closes the input's holes by the |winding number| = 0.5 surface; {} points of \
-                 it away from the input were added to the surface samples (caps), so sites stand there too.{far}",
+                 it beyond the input's edges were added to the surface samples (caps and their rims), so sites \
+                 stand there too.{far}",
                 self.solid.cap_samples
             )
         } else {

@@ -74,7 +74,8 @@ pub struct SolidReport {
     pub interior_surface_samples_dropped: usize,
     /// Points of the winding solid's boundary away from the input (caps across the holes
     /// of an open mesh: the |w| = 0.5 level set, found from the uniform pool, see
-    /// [`cap_samples`]) added to the surface samples, as dense as the input's, so that the
+    /// [`cap_samples`], and the rings where they meet the input's open edges, see
+    /// [`rim_samples`]) added to the surface samples, as dense as the input's, so that the
     /// initialisation puts site pairs and the polish pulls bisectors there too (winding
     /// solid of an open mesh only).
     pub cap_samples: usize,
@@ -297,6 +298,164 @@ pub fn cap_samples(
     Ok((points, frames, base))
 }
 
+/// Points on the caps' rims: the ring, [`CAP_CLEARANCE`] pair spacings wide, where a cap
+/// meets the input and [`cap_samples`] keeps none. Near an open edge the winding number
+/// turns with the angle about the edge (by 1/2π a radian), so the level set |w| = 0.5
+/// leaves the edge as a half-plane: in the input's own plane where the rest of the mesh
+/// adds 0.5 (a smooth hole), at an angle where it does not (a hole's rim on a fold). Each
+/// boundary edge's ring is cut into [`RIM_SLABS`] slabs by the distance s from the edge;
+/// at the edge's midpoint and each slab's middle s, the angle φ out of the triangle's plane
+/// (kept within [`RIM_MAX_TURN`] of it, so the search never crosses the input) where
+/// |w| = 0.5 is found by secant steps, with one winding number a step (Newton on the
+/// gradient, as the caps are found, needs six a step and probes so close to the edge that
+/// the fast mode falls back to the exact sum: libigl's truck took 8 s more). A slab is
+/// kept when its point lands within [`CAP_PRECISION`] spacings of the level set and its own
+/// edge is the nearest part of the input (a rim that runs into other faces, as in a soup,
+/// has no cap there); it gets one point per `area_per_sample` of its area, uniform over
+/// the edge's length and the slab's width, on that half-plane, with the half-plane's unit
+/// normal. Unit frame.
+///
+/// Why: without them the crust over the ring was left to the pairs nearby, and the polish,
+/// which pulls the crust only where there are samples, left a sawtooth along every cap's
+/// rim (libigl's halftunnel, face, camelhead).
+fn rim_samples(
+    oracle: &MeshOracle,
+    unit: &TriMesh,
+    spacing: f64,
+    area_per_sample: f64,
+    seed: u64,
+) -> Result<(Vec<[f64; 3]>, Vec<[f64; 3]>), FitError> {
+    let fail = |e: occupancy::OccupancyError| FitError::Failure(format!("rim samples: {e}"));
+    let width = CAP_CLEARANCE * spacing;
+    // Edges longer than the ring is wide are cut into pieces no longer: along a long edge
+    // the rest of the mesh adds different amounts, and the half-plane turns (a soup's).
+    let frames: Vec<RimEdge> = rim_with_frames(unit, &boundary_edges(unit))
+        .into_iter()
+        .flat_map(|(a, b, n, d)| {
+            let pieces = (dist(a, b) / width).ceil().clamp(1.0, 1e6) as usize;
+            (0..pieces).map(move |i| {
+                let (t0, t1) = (i as f64 / pieces as f64, (i + 1) as f64 / pieces as f64);
+                ([0, 1, 2].map(|k| a[k] + t0 * (b[k] - a[k])), [0, 1, 2].map(|k| a[k] + t1 * (b[k] - a[k])), n, d)
+            })
+        })
+        .collect();
+    if frames.is_empty() || !(area_per_sample > 0.0) {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let slab = width / RIM_SLABS as f64;
+    // The point at distance s from the edge's point m, turned by φ out of the triangle's plane.
+    let at = |(_, _, n, d): &RimEdge, m: [f64; 3], s: f64, phi: f64| {
+        let (c, sn) = (phi.cos(), phi.sin());
+        [0, 1, 2].map(|k| m[k] + s * (c * d[k] + sn * n[k]))
+    };
+    let mid = |(a, b, ..): &RimEdge| [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+    // One solve per (edge, slab): its middle distance.
+    let solves: Vec<(usize, f64)> =
+        (0..frames.len()).flat_map(|e| (0..RIM_SLABS).map(move |j| (e, slab * (j as f64 + 0.5)))).collect();
+    let value = |phis: &[f64]| -> Result<Vec<f64>, FitError> {
+        let points: Vec<[f64; 3]> = solves
+            .iter()
+            .zip(phis)
+            .map(|(&(e, s), &phi)| at(&frames[e], mid(&frames[e]), s, phi).map(|x| x.clamp(0.0, 1.0)))
+            .collect();
+        let w = oracle.winding_numbers(&points, occupancy::WindingMode::Fast).map_err(fail)?;
+        Ok(w.iter().map(|w| w.abs() - 0.5).collect())
+    };
+    let (mut p0, mut p1) = (vec![0.0; solves.len()], vec![RIM_FIRST_TURN; solves.len()]);
+    let (mut f0, mut f1) = (value(&p0)?, value(&p1)?);
+    for _ in 0..RIM_SECANT_STEPS {
+        let p2: Vec<f64> = (0..solves.len())
+            .map(|i| {
+                let df = f1[i] - f0[i];
+                if df != 0.0 && df.is_finite() {
+                    (p1[i] - f1[i] * (p1[i] - p0[i]) / df).clamp(-RIM_MAX_TURN, RIM_MAX_TURN)
+                } else {
+                    p1[i]
+                }
+            })
+            .collect();
+        let f2 = value(&p2)?;
+        (p0, f0) = (std::mem::replace(&mut p1, p2), std::mem::replace(&mut f1, f2));
+    }
+    let points: Vec<[f64; 3]> =
+        solves.iter().zip(&p1).map(|(&(e, s), &phi)| at(&frames[e], mid(&frames[e]), s, phi)).collect();
+    let nearest = oracle
+        .closest_points(&points.iter().map(|p| p.map(|x| x.clamp(0.0, 1.0))).collect::<Vec<_>>())
+        .map_err(fail)?;
+    let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 8);
+    // Candidates: point, normal, distance from its edge piece's line.
+    let mut candidates: Vec<([f64; 3], [f64; 3], f64)> = Vec::new();
+    for (i, &(e, s)) in solves.iter().enumerate() {
+        // Distance to the level set: |f| over |w|'s rate across the half-plane, 1/(2π s)
+        // by the edge alone; the edge is the nearest input.
+        let off = 2.0 * std::f64::consts::PI * s * f1[i].abs();
+        if !(off <= CAP_PRECISION * spacing) || nearest[i].squared_distance < (RIM_OWN_EDGE * s).powi(2) {
+            continue;
+        }
+        let frame = &frames[e];
+        let (a, b, ..) = *frame;
+        let turned = at(frame, [0.0; 3], 1.0, p1[i]);
+        let along = [0, 1, 2].map(|k| b[k] - a[k]);
+        let cross = [
+            along[1] * turned[2] - along[2] * turned[1],
+            along[2] * turned[0] - along[0] * turned[2],
+            along[0] * turned[1] - along[1] * turned[0],
+        ];
+        let l = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt();
+        if !(l > 0.0) {
+            continue;
+        }
+        let normal = cross.map(|x| x / l);
+        let expected = dist(a, b) * slab / area_per_sample;
+        let count = expected.floor() as usize + usize::from(rng.uniform() < expected.fract());
+        for _ in 0..count {
+            let u = rng.uniform();
+            let r = s + slab * (rng.uniform() - 0.5);
+            let base = [0, 1, 2].map(|k| a[k] + u * along[k]);
+            let q = [0, 1, 2].map(|k| base[k] + r * turned[k]);
+            if q.iter().all(|x| (0.0..=1.0).contains(x)) {
+                candidates.push((q, normal, r));
+            }
+        }
+    }
+    // Each point is checked where it stands (one winding number and one closest point): the
+    // half-plane was found at its piece's middle only.
+    let points: Vec<[f64; 3]> = candidates.iter().map(|c| c.0).collect();
+    let w = oracle.winding_numbers(&points, occupancy::WindingMode::Fast).map_err(fail)?;
+    let nearest = oracle.closest_points(&points).map_err(fail)?;
+    let (mut out, mut normals) = (Vec::new(), Vec::new());
+    for (((q, normal, r), w), c) in candidates.into_iter().zip(w).zip(nearest) {
+        let off = 2.0 * std::f64::consts::PI * r * (w.abs() - 0.5).abs();
+        if off <= RIM_PRECISION * spacing && c.squared_distance >= (RIM_OWN_EDGE * r).powi(2) {
+            out.push(q);
+            normals.push(normal);
+        }
+    }
+    Ok((out, normals))
+}
+
+/// Largest distance of a rim point from the level set, estimated as 2π·r·||w| − 0.5| (r its
+/// distance from the edge), in pair spacings: looser than [`CAP_PRECISION`], which the
+/// piece's middle meets, since the level set curves away from the half-plane.
+const RIM_PRECISION: f64 = 0.03;
+
+/// Slabs of a rim's ring ([`rim_samples`]), by distance from the edge.
+const RIM_SLABS: usize = 4;
+
+/// The second angle of the secant search, radians out of the triangle's plane.
+const RIM_FIRST_TURN: f64 = 0.2;
+
+/// Secant steps of the rim's search after its first two angles.
+const RIM_SECANT_STEPS: usize = 6;
+
+/// Largest turn of a rim's half-plane out of its triangle's plane, radians (short of the
+/// triangle itself, at ±π).
+const RIM_MAX_TURN: f64 = 2.8;
+
+/// A rim slab is kept when the input is no nearer to its point than this share of its
+/// distance from its own edge.
+const RIM_OWN_EDGE: f64 = 0.9;
+
 /// A Newton step's moved point and |∇w| where it started ([`cap_samples`]), if it held.
 type Stepped = Option<([f64; 3], f64)>;
 
@@ -344,7 +503,8 @@ const CAP_THINNING: f64 = 0.5;
 /// Newton put on the caps (half a pair spacing apart) go to seeded places among the first
 /// 12·K surface samples (the initialisation's candidates), with the samples they displace
 /// moved to the end, so the initialisation puts pairs there; the points of their tangent
-/// disks are appended, for the polish. Returns how many were added.
+/// disks are appended, for the polish, and so are the points of the rims' rings
+/// ([`rim_samples`] of `unit`, the input in the unit frame). Returns how many were added.
 ///
 /// Why as dense: the polish draws its batches from the surface samples, and caps with a
 /// few thousand of the million (0.2% of the batches for a third of the area, libigl's
@@ -355,6 +515,7 @@ const CAP_THINNING: f64 = 0.5;
 /// (4.16 → 4.17%, 4.186 → 4.194%; their caps are smooth and need fewer pairs).
 fn add_cap_samples(
     oracle: &MeshOracle,
+    unit: &TriMesh,
     data: &mut TrainingData,
     num_uniform: usize,
     area: f64,
@@ -389,7 +550,12 @@ fn add_cap_samples(
             data.normals.push(normal);
         }
     }
-    Ok(points.len())
+    // The rims' points are appended, for the polish only: the caps' Newton points already
+    // give the initialisation its pairs beside them.
+    let (rim, rim_normals) = rim_samples(oracle, unit, spacing, area / n as f64, seed)?;
+    data.surface.extend_from_slice(&rim);
+    data.normals.extend_from_slice(&rim_normals);
+    Ok(points.len() + rim.len())
 }
 
 /// Chooses the solid for `data` (labelled by `winding`, near-surface samples from
@@ -437,7 +603,15 @@ pub(crate) fn choose<'a>(
         let caps = if is_closed {
             0
         } else {
-            add_cap_samples(oracle, data, num_uniform, sampler.total_area(), config.train.num_sites, config.train.seed)?
+            add_cap_samples(
+                oracle,
+                unit,
+                data,
+                num_uniform,
+                sampler.total_area(),
+                config.train.num_sites,
+                config.train.seed,
+            )?
         };
         let report = SolidReport {
             rule: SolidRule::Winding,
