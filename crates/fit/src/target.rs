@@ -396,16 +396,12 @@ fn rim_samples(
         let (a, b, ..) = *frame;
         let turned = at(frame, [0.0; 3], 1.0, p1[i]);
         let along = [0, 1, 2].map(|k| b[k] - a[k]);
-        let cross = [
-            along[1] * turned[2] - along[2] * turned[1],
-            along[2] * turned[0] - along[0] * turned[2],
-            along[0] * turned[1] - along[1] * turned[0],
-        ];
-        let l = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt();
+        let c = cross(along, turned);
+        let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
         if !(l > 0.0) {
             continue;
         }
-        let normal = cross.map(|x| x / l);
+        let normal = c.map(|x| x / l);
         let expected = dist(a, b) * slab / area_per_sample;
         let count = expected.floor() as usize + usize::from(rng.uniform() < expected.fract());
         for _ in 0..count {
@@ -463,12 +459,15 @@ type Stepped = Option<([f64; 3], f64)>;
 /// helpers are private to it, as carve.rs notes for its `dot`).
 fn tangents(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let a = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
-    let cross =
-        |x: [f64; 3], y: [f64; 3]| [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
     let u = cross(n, a);
     let l = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
     let u = u.map(|x| x / l);
     (u, cross(n, u))
+}
+
+/// x × y.
+fn cross(x: [f64; 3], y: [f64; 3]) -> [f64; 3] {
+    [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]]
 }
 
 /// Points on a cap, their unit normals and how many of them (the first) were Newton's
@@ -969,8 +968,6 @@ fn boundary_edges(mesh: &TriMesh) -> Vec<([f64; 3], [f64; 3], u32)> {
 /// skipped).
 fn rim_with_frames(mesh: &TriMesh, rim: &[([f64; 3], [f64; 3], u32)]) -> Vec<RimEdge> {
     let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    let cross =
-        |u: [f64; 3], v: [f64; 3]| [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
     let unit = |v: [f64; 3]| {
         let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         (l > 0.0).then(|| v.map(|x| x / l))
