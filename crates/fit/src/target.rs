@@ -311,10 +311,11 @@ pub fn cap_samples(
 /// the fast mode falls back to the exact sum: libigl's truck took 8 s more). A slab is
 /// kept when its point lands within [`CAP_PRECISION`] spacings of the level set and its own
 /// edge is the nearest part of the input (a rim that runs into other faces, as in a soup,
-/// has no cap there; slabs whose straight continuation fails that are not searched); it
-/// gets one point per `area_per_sample` of its area, uniform over
-/// the edge's length and the slab's width, on that half-plane, with the half-plane's unit
-/// normal. Unit frame.
+/// has no cap there; above [`RIM_SEARCH_BUDGET`] searches, slabs whose straight
+/// continuation fails that are not searched); it gets one point per `area_per_sample` of
+/// its area, uniform over the edge's length and the slab's width, on that half-plane, with
+/// the half-plane's unit normal, and each point is kept when it passes the same two tests
+/// where it stands (within [`RIM_PRECISION`]). Unit frame.
 ///
 /// Why: without them the crust over the ring was left to the pairs nearby, and the polish,
 /// which pulls the crust only where there are samples, left a sawtooth along every cap's

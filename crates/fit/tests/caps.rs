@@ -5,6 +5,7 @@
 use fit::{FitConfig, NoProgress, SolidRule};
 use mesh_io::shapes::icosphere;
 use mesh_io::TriMesh;
+use occupancy::distance::closest_point_triangle::closest_point_segment;
 use occupancy::{Config, MeshOracle, WindingMode};
 
 fn small(name: &str) -> FitConfig {
@@ -69,10 +70,19 @@ fn the_crust_follows_the_solid_across_a_hole() {
 
     // The rim: crust faces whose nearest input point is on the hole's edge, nearer than the
     // cap samples' clearance (0.1 here is beyond it), also turn with the level set.
-    let rim = rim_edges(&mesh);
+    let rim: Vec<([f64; 3], [f64; 3])> = mesh_io::topology::boundary_edges(&mesh)
+        .into_iter()
+        .map(|(a, b)| (mesh.positions[a as usize], mesh.positions[b as usize]))
+        .collect();
+    let on_rim = |p: [f64; 3]| {
+        rim.iter().any(|&(a, b)| {
+            let q = closest_point_segment(p, a, b);
+            (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>() < 1e-18
+        })
+    };
     let ring = |_: &[f64; 3], closest: &occupancy::ClosestPoint| {
         let d = closest.squared_distance.sqrt();
-        d > 0.01 && d <= 0.1 && rim.iter().any(|&(a, b)| segment_distance(closest.point, a, b) < 1e-9)
+        d > 0.01 && d <= 0.1 && on_rim(closest.point)
     };
     let (agree, total) = agreement(&oracle, &out.crust, ring);
     let rim_smooth = agree / total;
@@ -118,29 +128,4 @@ fn agreement(
         }
     }
     (agree, total)
-}
-
-/// The edges of `mesh` with one incident triangle.
-fn rim_edges(mesh: &TriMesh) -> Vec<([f64; 3], [f64; 3])> {
-    let mut count = std::collections::HashMap::new();
-    for t in &mesh.triangles {
-        for e in 0..3 {
-            let (a, b) = (t[e], t[(e + 1) % 3]);
-            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-        }
-    }
-    count
-        .into_iter()
-        .filter(|&(_, n)| n == 1)
-        .map(|((a, b), _)| (mesh.positions[a as usize], mesh.positions[b as usize]))
-        .collect()
-}
-
-fn segment_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
-    let ab = [0, 1, 2].map(|c| b[c] - a[c]);
-    let ap = [0, 1, 2].map(|c| p[c] - a[c]);
-    let l2: f64 = ab.iter().map(|x| x * x).sum();
-    let t = if l2 > 0.0 { ((0..3).map(|c| ab[c] * ap[c]).sum::<f64>() / l2).clamp(0.0, 1.0) } else { 0.0 };
-    let q = [0, 1, 2].map(|c| a[c] + t * ab[c]);
-    (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt()
 }
