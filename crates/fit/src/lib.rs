@@ -26,6 +26,7 @@ pub mod config;
 pub mod crust_step;
 pub mod data;
 pub mod error;
+pub mod grading;
 pub mod grow;
 pub mod guard;
 pub mod options;

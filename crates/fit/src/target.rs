@@ -4,17 +4,20 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use crust::output::{FrameMap, Precision};
 use mesh_io::TriMesh;
 use occupancy::sample::SurfaceSampler;
 use occupancy::MeshOracle;
 use serde::Serialize;
-use soft_voronoi::init::{greedy_disk, poisson_subset};
+use soft_voronoi::init::greedy_disk;
 use soft_voronoi::{MeshSolid, ShellSolid, Solid, TrainingData};
 use vf_common::rng::{ChunkRng, Stream};
 
 use crate::config::{shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE};
 use crate::error::FitError;
+use crate::grading;
 
 /// The solid in use; the shell comes with its own initial sites ([`shell_sites`]).
 pub(crate) enum Target<'a> {
@@ -659,18 +662,11 @@ pub(crate) fn choose<'a>(
     let h0 = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
     let k = config.train.num_sites;
     let m = data.surface.len().min(12 * k);
+    let plan = ShellPlan::new(unit, sampler.total_area(), &data.surface[..m], &data.normals[..m], k);
     let place = |h: f64, data: &TrainingData| {
         let solid = ShellSolid::new(oracle, unit, h);
-        let (sites, labels, counts) = shell_sites(
-            unit,
-            sampler.total_area(),
-            &data.surface[..m],
-            &data.normals[..m],
-            &solid,
-            k,
-            data,
-            config.train.seed,
-        );
+        let (sites, labels, counts) =
+            shell_sites(&plan, &data.surface[..m], &data.normals[..m], &solid, k, data, config.train.seed);
         (solid, sites, labels, counts)
     };
     let (h, thickness_search) = if s.shell_thickness.is_none() && !config.train_shell {
@@ -697,8 +693,9 @@ pub(crate) fn choose<'a>(
         half_thickness: Some(h / scale),
         half_thickness_of_diagonal: Some(h / diagonal),
         init: Some(format!(
-            "{triplets} triplets (inside on the surface, outside at ±2h along the normal) and {rims} rim quadruplets \
-             (one more outside site 2h beyond the open boundary){}",
+            "{triplets} triplets (inside on the surface, outside at ±2h along the normal; spaced by how far the \
+             sheet bends, and more where the band had a hole) and {rims} rim quadruplets (one more outside site 2h \
+             beyond the open boundary, two at a corner){}",
             if config.train_shell {
                 ", then trained"
             } else {
@@ -722,7 +719,7 @@ pub(crate) fn choose<'a>(
 /// steps about s²κ/2 high (spacing s, curvature κ), and a band thinner than its steps
 /// breaks into holes: at 0.25% of the diagonal the lilium came out of genus 260 and the
 /// beetle's body of genus 206 (from 0 and 10). So each band's crust is checked.
-pub const BAND_FACTORS: [f64; 4] = [0.3, 0.4, 0.5, 0.7];
+pub const BAND_FACTORS: [f64; 6] = [0.15, 0.2, 0.3, 0.4, 0.5, 0.7];
 
 /// The thinnest band of [`BAND_FACTORS`]·`h0` whose crust (of the sites `place` puts for
 /// it, as constructed) has the same components and genus as the default band's, and a
@@ -767,6 +764,14 @@ fn thinnest_band(
             error: None,
         })
     };
+    // The genus a thin band of the sheet has: its boundary is a double cover of the sheet
+    // (χ twice the sheet's), so 1 − χ per component, when every edge has at most two
+    // triangles. The default band can miss it (libigl's beetle, a genus-1 sheet with 11
+    // holes: 12 expected, 10 at the default band, whose thickness closes two small windows),
+    // so a thinner band nearer it is taken; otherwise the default's genus is the reference.
+    let topology = mesh_io::topology::TopologyReport::of(unit);
+    let expected_genus =
+        (topology.num_non_manifold_edges == 0).then(|| topology.num_components as i64 - topology.euler_characteristic);
     let mut trials = vec![trial(1.0)?];
     let mut kept = 0;
     for factor in BAND_FACTORS {
@@ -788,8 +793,12 @@ fn thinnest_band(
             }
         };
         let reference = &trials[0];
+        let genus_holds = match (expected_genus, t.genus, reference.genus) {
+            (Some(g), Some(a), Some(b)) => (a - g).abs() <= (b - g).abs(),
+            _ => t.genus == reference.genus,
+        };
         let holds = t.components == reference.components
-            && t.genus == reference.genus
+            && genus_holds
             && t.hausdorff_of_diagonal <= reference.hausdorff_of_diagonal;
         trials.push(t);
         if holds {
@@ -801,18 +810,157 @@ fn thinnest_band(
     Ok((trials[kept].factor * h0, trials))
 }
 
+/// What the shell's sites are placed from, whatever the band's thickness: the candidate
+/// rim points (corners first, with their two edges' outward directions) and how much the
+/// sheet bends around every candidate surface and rim point ([`crate::grading`]).
+struct ShellPlan {
+    /// The spacing ladder, widest (2s) first.
+    radii: [f64; grading::LEVELS],
+    /// Bending of the sheet around each candidate surface point, per radius.
+    surface_bend: Vec<[f64; grading::LEVELS]>,
+    /// Candidate rim points, the corners first.
+    rim: Vec<RimPoint>,
+    /// The outward directions of each corner's two edges (the first `corner_edges.len()`
+    /// of `rim`).
+    corner_edges: Vec<[[f64; 3]; 2]>,
+    /// Bending around each rim candidate: of the sheet, or of the rim in the sheet's plane.
+    rim_bend: Vec<[f64; grading::LEVELS]>,
+}
+
+impl ShellPlan {
+    fn new(unit: &TriMesh, area: f64, surface: &[[f64; 3]], normals: &[[f64; 3]], k: usize) -> ShellPlan {
+        let rim = boundary_edges(unit);
+        let length: f64 = rim.iter().map(|e| dist(e.0, e.1)).sum();
+        let b = 4.0 * length / RIM_SPACING;
+        let u = (-b + (b * b + 12.0 * area * k as f64).sqrt()) / (6.0 * area).max(1e-300);
+        let s = 1.0 / u.max(1e-300);
+        let radii = grading::ladder(2.0 * s);
+        // Rim candidates every eighth of the finest rim spacing along each boundary edge (at
+        // least one per edge). The rim's corners come first and are always kept: without a
+        // point there the band stays open around the corner (the benchmark's sheet grew a
+        // spike of 4.6% of the diagonal past a corner at K = 2,048).
+        let frames = rim_with_frames(unit, &rim);
+        let corners = rim_corners(&frames);
+        let mut candidates: Vec<RimPoint> = corners.iter().map(|c| c.0).collect();
+        let step = RIM_SPACING * radii[grading::LEVELS - 1] / 8.0;
+        for &(a, b, n, d) in &frames {
+            let count = (dist(a, b) / step).ceil().max(1.0) as usize;
+            for j in 0..count {
+                let t = (j as f64 + 0.5) / count as f64;
+                candidates.push(([0, 1, 2].map(|c| a[c] + t * (b[c] - a[c])), n, d));
+            }
+        }
+        let surface_bend = grading::spread(surface, &grading::bending(surface, normals, surface, &radii), &radii);
+        let at: Vec<[f64; 3]> = candidates.iter().map(|c| c.0).collect();
+        let (rim_n, rim_d): (Vec<[f64; 3]>, Vec<[f64; 3]>) = candidates.iter().map(|c| (c.1, c.2)).unzip();
+        let sheet = grading::bending(&at, &rim_n, surface, &radii);
+        let turn = grading::bending(&at, &rim_d, &at, &radii);
+        let rim_bend = sheet.iter().zip(&turn).map(|(a, b)| std::array::from_fn(|l| a[l].max(b[l]))).collect();
+        ShellPlan {
+            radii,
+            surface_bend,
+            rim: candidates,
+            corner_edges: corners.iter().map(|c| c.1).collect(),
+            rim_bend,
+        }
+    }
+}
+
+/// The rim points and triplet centres for the band of half-thickness `h` (indices into the
+/// plan's rim candidates and into the surface candidates), within K sites.
+///
+/// Each candidate's spacing is the widest over which the sheet (and for a rim point, the
+/// rim) bends less than [`grading::BEND_SHARE`]·h, clamped to [lo, hi]: hi is lowered from
+/// 2s (flat parts give sites to curved ones) to the densest layout that fits in K; if the
+/// bends need more than K even so, lo is raised instead (the band's thinnest parts then
+/// rest on fewer triplets than they need, and the band's check will tell). Rim points lie
+/// at [`RIM_SPACING`] times the spacing, the triplets keep their spacing from them too: an
+/// inside site nearer the rim than the rim points are to each other has a cell running on
+/// beyond the rim, between the rim points' outside sites (the sheets' farthest crust
+/// points were there).
+fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> (Vec<u32>, Vec<u32>) {
+    let limit = grading::BEND_SHARE * h;
+    let radii = &plan.radii;
+    let cap_surface: Vec<f64> = plan.surface_bend.iter().map(|b| grading::widest_flat(b, radii, limit)).collect();
+    let cap_rim: Vec<f64> = plan.rim_bend.iter().map(|b| grading::widest_flat(b, radii, limit)).collect();
+    let rim_at: Vec<[f64; 3]> = plan.rim.iter().map(|c| c.0).collect();
+    let corners = plan.corner_edges.len();
+    let layout = |lo: f64, hi: f64| -> (Vec<u32>, Vec<u32>, usize) {
+        let mut spread = 1.0;
+        let (rim, rim_sites) = loop {
+            let r: Vec<f64> = cap_rim.iter().map(|c| spread * RIM_SPACING * c.clamp(lo, hi)).collect();
+            let mut rim = grading::graded_subset(&[], &rim_at[..corners], &r[..corners]);
+            let kept: Vec<[f64; 3]> = rim.iter().map(|&i| rim_at[i as usize]).collect();
+            rim.extend(
+                grading::graded_subset(&kept, &rim_at[corners..], &r[corners..])
+                    .into_iter()
+                    .map(|i| i + corners as u32),
+            );
+            let sites = 4 * rim.len() + 2 * rim.iter().filter(|&&i| (i as usize) < corners).count();
+            // More rim than a quarter of the budget: spread the rim points wider.
+            if sites <= k / 4 || spread > 64.0 {
+                break (rim, sites);
+            }
+            spread *= 1.25;
+        };
+        let kept: Vec<[f64; 3]> = rim.iter().map(|&i| rim_at[i as usize]).collect();
+        let r: Vec<f64> = cap_surface.iter().map(|c| c.clamp(lo, hi)).collect();
+        let triplets = grading::graded_subset(&kept, surface, &r);
+        let total = rim_sites + 3 * triplets.len();
+        (rim, triplets, total)
+    };
+    let (finest, widest) = (radii[grading::LEVELS - 1], radii[0]);
+    let at_widest = layout(finest, widest);
+    let mut best = None;
+    if at_widest.2 <= k {
+        // Lower hi (log-bisection) to the densest layout within K.
+        let (mut a, mut b) = (finest.ln(), widest.ln());
+        best = Some(at_widest);
+        for _ in 0..12 {
+            let mid = 0.5 * (a + b);
+            let got = layout(finest, mid.exp());
+            if got.2 <= k {
+                b = mid;
+                best = Some(got);
+            } else {
+                a = mid;
+            }
+        }
+    } else {
+        // Too many bends for K: raise lo until it fits (at lo = hi = 2s it always does).
+        let (mut a, mut b) = (finest.ln(), widest.ln());
+        for _ in 0..12 {
+            let mid = 0.5 * (a + b);
+            let got = layout(mid.exp(), widest);
+            if got.2 <= k {
+                b = mid;
+                best = Some(got);
+            } else {
+                a = mid;
+            }
+        }
+    }
+    let (mut rim, mut triplets, _) = best.unwrap_or_else(|| layout(widest, widest));
+    // Within K even when the last layout overshoots (a rim alone over K): rim points beyond
+    // K are dropped (a corner's two extra sites are placed only where room is left).
+    rim.truncate(k / 4);
+    let rim_sites = 4 * rim.len() + 2 * rim.iter().filter(|&&i| (i as usize) < corners).count();
+    triplets.truncate(k.saturating_sub(rim_sites) / 3);
+    (rim, triplets)
+}
+
 /// Initial sites for the shell of half-thickness h around `unit`: at Poisson-disk points p
 /// of the surface (from `surface`, area-uniform, with `normals`) an inside site at p and
 /// outside sites at p ± 2h·n, whose bisectors are the shell's two sides (exactly, on a flat
 /// part, whatever the spacing); along open boundary edges (meshes welded by position) the
 /// same plus an outside site 2h beyond the edge in the surface's plane, which closes the
-/// band there. Points are spread so that 3 per surface point and 4 per rim point make K;
-/// labels come from the solid (folds closer than 2h turn outside sites inside); unused
-/// slots are filled with training samples. Returns sites, labels and the two counts.
-#[allow(clippy::too_many_arguments)]
+/// band there, and at a rim's corner one more beyond each of its two edges. The points are
+/// spaced by how much the sheet bends ([`shell_layout`]) so that 3 per surface point, 4 per
+/// rim point and 2 per corner make K; labels come from the solid (folds closer than 2h turn
+/// outside sites inside); unused slots are filled with training samples. Returns sites,
+/// labels and the counts of triplets and rim points.
 fn shell_sites(
-    unit: &TriMesh,
-    area: f64,
+    plan: &ShellPlan,
     surface: &[[f64; 3]],
     normals: &[[f64; 3]],
     solid: &ShellSolid,
@@ -821,44 +969,16 @@ fn shell_sites(
     seed: u64,
 ) -> (Vec<[f64; 3]>, Vec<bool>, (usize, usize)) {
     let h = solid.half_thickness;
-    let rim = boundary_edges(unit);
-    let length: f64 = rim.iter().map(|e| dist(e.0, e.1)).sum();
-    // 3·A/s² + 4·L/(ρ·s) = K for the spacing s (ρ = RIM_SPACING: rim points are closer).
-    let b = 4.0 * length / RIM_SPACING;
-    let u = (-b + (b * b + 12.0 * area * k as f64).sqrt()) / (6.0 * area).max(1e-300);
-    let s = 1.0 / u.max(1e-300);
-    // Rim points spaced [`RIM_SPACING`]·s along the boundary: candidates every s/4 along each
-    // boundary edge (at least one per edge), then those with no other that near, greedily in
-    // edge order (a subset truncated to a count would drop a stretch of rim at the end of
-    // the list and leave the band open there). One point per edge at least, as before, gave
-    // a finely meshed rim far more points than L/s: on libigl's beetle body the rims took
-    // 4,544 of the 8,192 sites and left 1,216 triplets for the whole surface, on its truck
-    // 7,320 and 290.
-    // The rim's corners come first, so the greedy pass keeps them: without a point there the
-    // band stays open around the corner (the benchmark's sheet grew a spike of 4.6% of the
-    // diagonal past a corner at K = 2,048).
-    let frames = rim_with_frames(unit, &rim);
-    let mut candidates: Vec<RimPoint> = rim_corners(&frames);
-    for &(a, b, n, d) in &frames {
-        let count = (4.0 * dist(a, b) / s).ceil().max(1.0) as usize;
-        for j in 0..count {
-            let t = (j as f64 + 0.5) / count as f64;
-            candidates.push(([0, 1, 2].map(|c| a[c] + t * (b[c] - a[c])), n, d));
-        }
-    }
-    let points: Vec<[f64; 3]> = candidates.iter().map(|c| c.0).collect();
-    let mut r = RIM_SPACING * s;
-    let mut picked = greedy_disk(&points, r);
-    while picked.len() > k / 4 && r < 2.0 {
-        // More rim than a quarter of the budget: spread the rim points wider (at r ≥ √3 one
-        // point is left in the unit cube).
-        r *= 1.25;
-        picked = greedy_disk(&points, r);
-    }
-    picked.truncate(k / 4);
-    let rim_points: Vec<RimPoint> = picked.iter().map(|&i| candidates[i as usize]).collect();
-    let triplets = (k - 4 * rim_points.len()) / 3;
-    let (chosen, _) = poisson_subset(surface, triplets.min(surface.len()));
+    let (rim, chosen) = shell_layout(plan, surface, h, k - k / SHELL_REPAIR_RESERVE);
+    let rim_points: Vec<RimPoint> = rim.iter().map(|&i| plan.rim[i as usize]).collect();
+    // A corner's two edges each get an outside site 2h beyond them as well: the one along
+    // the mean direction alone left the band running on past both edges near the corner
+    // (libigl's grid.off: 3.3h beyond its edges by each corner, its Hausdorff distance).
+    let corner_edges: Vec<([f64; 3], [[f64; 3]; 2])> = rim
+        .iter()
+        .filter(|&&i| (i as usize) < plan.corner_edges.len())
+        .map(|&i| (plan.rim[i as usize].0, plan.corner_edges[i as usize]))
+        .collect();
     let clamp = |p: [f64; 3]| p.map(|x| x.clamp(1e-6, 1.0 - 1e-6));
     let along = |p: [f64; 3], v: [f64; 3], f: f64| clamp([0, 1, 2].map(|c| p[c] + f * v[c]));
     let mut sites = Vec::with_capacity(k);
@@ -869,14 +989,52 @@ fn shell_sites(
     for &(p, n, d) in &rim_points {
         sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h), along(p, d, 2.0 * h)]);
     }
+    for &(p, edges) in &corner_edges {
+        if sites.len() + 2 <= k {
+            sites.extend(edges.map(|d| along(p, d, 2.0 * h)));
+        }
+    }
     let mut labels = solid.inside(&sites);
+    // Repairs: a surface point whose nearest site is outside lies in a hole through the band
+    // (the sheet bends more between triplets than the spacing's measure saw, or two
+    // triplets' spacings differ too much); a triplet there closes it. Up to the reserve of K.
+    let mut repaired = 0;
+    for _ in 0..SHELL_REPAIR_ROUNDS {
+        let room = k.saturating_sub(sites.len()) / 3;
+        if room == 0 || sites.is_empty() {
+            break;
+        }
+        let index = soft_voronoi::SiteIndex::new(&sites);
+        let holes: Vec<usize> = (0..surface.len())
+            .into_par_iter()
+            .filter(|&i| !labels[index.nearest(&sites, surface[i]).0 as usize])
+            .collect();
+        if holes.is_empty() {
+            break;
+        }
+        let at: Vec<[f64; 3]> = holes.iter().map(|&i| surface[i]).collect();
+        let mut fix = greedy_disk(&at, plan.radii[grading::LEVELS - 1]);
+        fix.truncate(room);
+        let start = sites.len();
+        for &j in &fix {
+            let (p, n) = (surface[holes[j as usize]], normals[holes[j as usize]]);
+            sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h)]);
+        }
+        labels.extend(solid.inside(&sites[start..]));
+        repaired += fix.len();
+    }
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 5);
-    // The slots the triplets and rim points leave (a few) get pool points outside the band
-    // and at least 2h from it, labelled outside: they only split empty space. A pool point
+    // The slots the triplets, rim points and repairs leave (up to the unused repair reserve)
+    // get pool points outside the band and far from it, labelled outside: they only split
+    // empty space. A pool point
     // inside the band, off the triplets' lines, put a speck in the flat crust of libigl's
     // grid.off (the one fill site, 0.0015 from the sheet); a point that close outside would
     // dent it. Points elsewhere (labelled by the band) only if the pool has none so far.
     let missing = k.saturating_sub(sites.len());
+    // Farther from the band than the widest spacing between triplet centres, so no sheet
+    // point is nearer a fill site than its nearest centre (at 2h only, fill sites punched
+    // holes between the widely spaced centres of a flat part).
+    let clearance = plan.radii[0] + h;
     let mut far = Vec::with_capacity(missing);
     let mut tried = 0;
     while far.len() < missing && tried < 64 * missing.max(1) && !data.points.is_empty() {
@@ -884,7 +1042,7 @@ fn shell_sites(
             (0..256).map(|_| data.points[(rng.next_u64() % data.points.len() as u64) as usize]).collect();
         tried += batch.len();
         for (p, l) in batch.iter().zip(solid.locate(&batch)) {
-            if far.len() < missing && !l.inside && dist(*p, l.closest) >= 2.0 * h && !far.contains(p) {
+            if far.len() < missing && !l.inside && dist(*p, l.closest) >= clearance && !far.contains(p) {
                 far.push(*p);
             }
         }
@@ -897,8 +1055,15 @@ fn shell_sites(
     }
     // Labelled by this band (the pool's labels may be another solid's).
     labels.extend(solid.inside(&sites[filled..]));
-    (sites, labels, (chosen.len(), rim_points.len()))
+    (sites, labels, (chosen.len() + repaired, rim_points.len()))
 }
+
+/// A shell's layout leaves K/`SHELL_REPAIR_RESERVE` sites for the triplets that close its
+/// holes.
+const SHELL_REPAIR_RESERVE: usize = 8;
+
+/// Rounds of hole repair in a shell's sites.
+const SHELL_REPAIR_ROUNDS: usize = 6;
 
 /// A boundary edge (a, b) with its triangle's unit normal and the unit direction across the
 /// edge, away from the triangle, in its plane.
@@ -911,7 +1076,7 @@ type RimPoint = ([f64; 3], [f64; 3], [f64; 3]);
 /// vertices (by position) with exactly two boundary edges that meet at an angle below 150°
 /// (a straight rim: 180°), each with the mean of its edges' normals and of their outward
 /// directions (unit), sorted by position so the order does not depend on hashing.
-fn rim_corners(frames: &[RimEdge]) -> Vec<RimPoint> {
+fn rim_corners(frames: &[RimEdge]) -> Vec<(RimPoint, [[f64; 3]; 2])> {
     let mut at: HashMap<[u64; 3], Vec<(usize, [f64; 3])>> = HashMap::new();
     for (i, &(a, b, _, _)) in frames.iter().enumerate() {
         at.entry(a.map(f64::to_bits)).or_default().push((i, b));
@@ -921,7 +1086,7 @@ fn rim_corners(frames: &[RimEdge]) -> Vec<RimPoint> {
         let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         (l > 0.0).then(|| v.map(|x| x / l))
     };
-    let mut corners: Vec<([u64; 3], RimPoint)> = Vec::new();
+    let mut corners: Vec<([u64; 3], (RimPoint, [[f64; 3]; 2]))> = Vec::new();
     for (key, ends) in &at {
         let [(e, p), (f, q)] = ends[..] else { continue };
         let v = key.map(f64::from_bits);
@@ -936,7 +1101,7 @@ fn rim_corners(frames: &[RimEdge]) -> Vec<RimPoint> {
         let (nf, df) = (frames[f].2, frames[f].3);
         let n = unit([0, 1, 2].map(|c| ne[c] + nf[c])).unwrap_or(ne);
         let d = unit([0, 1, 2].map(|c| de[c] + df[c])).unwrap_or(de);
-        corners.push((*key, (v, n, d)));
+        corners.push((*key, ((v, n, d), [de, df])));
     }
     corners.sort_by_key(|c| c.0);
     corners.into_iter().map(|(_, p)| p).collect()
@@ -1071,14 +1236,16 @@ mod tests {
         let mut points: Vec<[f64; 3]> = (0..2000)
             .map(|_| [0.3 + 0.4 * rng.uniform(), 0.3 + 0.4 * rng.uniform(), 0.5 + h * (rng.uniform() - 0.5)])
             .collect();
-        points.extend((0..20).map(|i| [0.35 + 0.01 * i as f64, 0.5, 0.8]));
+        // (As many far points as a shell's repair reserve can leave unused.)
+        points.extend((0..400).map(|i| [0.31 + 0.00095 * i as f64, 0.5, 0.8 + 0.1 * (i % 2) as f64]));
         let occupancy = vec![true; points.len()];
         let data = TrainingData { points, occupancy, surface: surface.clone(), normals: normals.clone() };
         let mut filled = 0;
         for k in 300..310 {
-            let (sites, labels, (triplets, rims)) = shell_sites(&unit, 0.16, &surface, &normals, &solid, k, &data, 0);
+            let plan = ShellPlan::new(&unit, 0.16, &surface, &normals, k);
+            let (sites, labels, (triplets, rims)) = shell_sites(&plan, &surface, &normals, &solid, k, &data, 0);
             assert_eq!(sites.len(), k);
-            let placed = 3 * triplets + 4 * rims;
+            let placed = 3 * triplets + 4 * rims + 2 * 4;
             filled += k - placed;
             for (p, &inside) in sites[placed..].iter().zip(&labels[placed..]) {
                 assert!(!inside, "a fill site inside the band: {p:?}");
@@ -1107,7 +1274,7 @@ mod tests {
                 .unwrap();
         assert_eq!(h, 0.5 * h0, "{trials:?}");
         let genus: Vec<Option<i64>> = trials.iter().map(|t| t.genus).collect();
-        assert_eq!(genus, [Some(0), Some(1), Some(1), Some(0)], "{trials:?}");
+        assert_eq!(genus, [Some(0), Some(1), Some(1), Some(1), Some(1), Some(0)], "{trials:?}");
         assert_eq!(trials.iter().filter(|t| t.kept).count(), 1);
         // Broken at every thinner band: the default stays.
         let (h, trials) =

@@ -388,7 +388,7 @@ pub fn greedy_disk(points: &[[f64; 3]], r: f64) -> Vec<u32> {
 
 /// [`greedy_disk`] with `seeds` kept before any of `points` (only indices of `points` are
 /// returned).
-fn greedy_disk_around(seeds: &[[f64; 3]], points: &[[f64; 3]], r: f64) -> Vec<u32> {
+pub fn greedy_disk_around(seeds: &[[f64; 3]], points: &[[f64; 3]], r: f64) -> Vec<u32> {
     let mut grid = DiskGrid::new(r);
     seeds.iter().for_each(|&p| grid.insert(p));
     let mut kept = Vec::new();
