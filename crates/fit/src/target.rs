@@ -874,21 +874,25 @@ impl ShellPlan {
 /// 2s (flat parts give sites to curved ones) to the densest layout that fits in K; if the
 /// bends need more than K even so, lo is raised instead (the band's thinnest parts then
 /// rest on fewer triplets than they need, and the band's check will tell). Rim points lie
-/// at [`RIM_SPACING`] times the spacing, the triplets keep their spacing from them too: an
-/// inside site nearer the rim than the rim points are to each other has a cell running on
-/// beyond the rim, between the rim points' outside sites (the sheets' farthest crust
-/// points were there).
-fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> (Vec<u32>, Vec<u32>) {
+/// at [`RIM_SPACING`] times the spacing (at most that of the uniform spacing s), spread
+/// wider where the rim would take more than a third of K. The triplets keep their spacing from the rim points and stay [`clear_of_rim`]: an inside
+/// site nearer the rim than the rim points are to each other has a cell running on beyond
+/// the rim, between the rim points' outside sites (the sheets' farthest crust points were
+/// there: libigl's grid.off 3.3h beyond its edges by each corner).
+fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> Layout {
     let limit = grading::BEND_SHARE * h;
     let radii = &plan.radii;
     let cap_surface: Vec<f64> = plan.surface_bend.iter().map(|b| grading::widest_flat(b, radii, limit)).collect();
     let cap_rim: Vec<f64> = plan.rim_bend.iter().map(|b| grading::widest_flat(b, radii, limit)).collect();
     let rim_at: Vec<[f64; 3]> = plan.rim.iter().map(|c| c.0).collect();
     let corners = plan.corner_edges.len();
-    let layout = |lo: f64, hi: f64| -> (Vec<u32>, Vec<u32>, usize) {
+    let layout = |lo: f64, hi: f64| -> Layout {
         let mut spread = 1.0;
         let (rim, rim_sites) = loop {
-            let r: Vec<f64> = cap_rim.iter().map(|c| spread * RIM_SPACING * c.clamp(lo, hi)).collect();
+            // Never sparser than the uniform spacing's rim (radii[2] = s): between rim points
+            // 2s apart, as a flat part's spacing would allow, a petal's tip of libigl's
+            // lilium grew a spike of 2.9% of the diagonal at K = 2,048 (1.7% before).
+            let r: Vec<f64> = cap_rim.iter().map(|c| spread * RIM_SPACING * c.clamp(lo, hi).min(radii[2])).collect();
             let mut rim = grading::graded_subset(&[], &rim_at[..corners], &r[..corners]);
             let kept: Vec<[f64; 3]> = rim.iter().map(|&i| rim_at[i as usize]).collect();
             rim.extend(
@@ -897,29 +901,33 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> (Ve
                     .map(|i| i + corners as u32),
             );
             let sites = 4 * rim.len() + 2 * rim.iter().filter(|&&i| (i as usize) < corners).count();
-            // More rim than a quarter of the budget: spread the rim points wider.
-            if sites <= k / 4 || spread > 64.0 {
+            // More rim than a third of the budget: spread the rim points wider (a quarter, as
+            // before 2026-12-04, left the rim of libigl's beetle too sparse at K = 2,048).
+            if sites <= k / 3 || spread > 64.0 {
                 break (rim, sites);
             }
             spread *= 1.25;
         };
         let kept: Vec<[f64; 3]> = rim.iter().map(|&i| rim_at[i as usize]).collect();
-        let r: Vec<f64> = cap_surface.iter().map(|c| c.clamp(lo, hi)).collect();
-        let triplets = grading::graded_subset(&kept, surface, &r);
+        let clear = clear_of_rim(&kept, &rim_at, h, surface);
+        let ids: Vec<u32> = (0..surface.len() as u32).filter(|&i| clear[i as usize]).collect();
+        let pts: Vec<[f64; 3]> = ids.iter().map(|&i| surface[i as usize]).collect();
+        let r: Vec<f64> = ids.iter().map(|&i| cap_surface[i as usize].clamp(lo, hi)).collect();
+        let triplets: Vec<u32> = grading::graded_subset(&kept, &pts, &r).into_iter().map(|j| ids[j as usize]).collect();
         let total = rim_sites + 3 * triplets.len();
-        (rim, triplets, total)
+        Layout { rim, triplets, total, clear }
     };
     let (finest, widest) = (radii[grading::LEVELS - 1], radii[0]);
     let at_widest = layout(finest, widest);
     let mut best = None;
-    if at_widest.2 <= k {
+    if at_widest.total <= k {
         // Lower hi (log-bisection) to the densest layout within K.
         let (mut a, mut b) = (finest.ln(), widest.ln());
         best = Some(at_widest);
         for _ in 0..12 {
             let mid = 0.5 * (a + b);
             let got = layout(finest, mid.exp());
-            if got.2 <= k {
+            if got.total <= k {
                 b = mid;
                 best = Some(got);
             } else {
@@ -932,7 +940,7 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> (Ve
         for _ in 0..12 {
             let mid = 0.5 * (a + b);
             let got = layout(mid.exp(), widest);
-            if got.2 <= k {
+            if got.total <= k {
                 b = mid;
                 best = Some(got);
             } else {
@@ -940,13 +948,58 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> (Ve
             }
         }
     }
-    let (mut rim, mut triplets, _) = best.unwrap_or_else(|| layout(widest, widest));
+    let Layout { mut rim, mut triplets, clear, .. } = best.unwrap_or_else(|| layout(widest, widest));
     // Within K even when the last layout overshoots (a rim alone over K): rim points beyond
     // K are dropped (a corner's two extra sites are placed only where room is left).
     rim.truncate(k / 4);
     let rim_sites = 4 * rim.len() + 2 * rim.iter().filter(|&&i| (i as usize) < corners).count();
     triplets.truncate(k.saturating_sub(rim_sites) / 3);
-    (rim, triplets)
+    Layout { rim, triplets, total: 0, clear }
+}
+
+/// A thin shell's layout: rim points (indices into the plan's rim candidates), triplet
+/// centres (into the surface candidates), the sites they take, and which surface
+/// candidates lie clear of the rim ([`clear_of_rim`]).
+struct Layout {
+    rim: Vec<u32>,
+    triplets: Vec<u32>,
+    total: usize,
+    clear: Vec<bool>,
+}
+
+/// Which of `points` lie far enough from the rim for a triplet of the band of
+/// half-thickness `h`, given the rim points kept (`rim`) and the rim itself (`line`: points
+/// along it, closer together than the rim points). A point y = c + e·d beyond the rim (c on
+/// the rim, d outward) is nearer an inside site x, at distance a from the rim, than the
+/// outside sites 2h beyond the rim points, τ_c from c, when about
+/// |x − c|² + e² + 2a·e < τ_c² + (2h − e)²: x's cell runs on past the band's end (e = h)
+/// unless |x − c|² + 2a·h ≥ τ_c² for every c. Points for which that fails are not clear;
+/// the rim points' own cells cover them. A repair triplet 0.003 from the bottom edge of
+/// libigl's beetle at K = 2,048 grew a spike of 8.7% of the diagonal, and on a square sheet
+/// at K = 1,024 a triplet 0.042 from the edge, across from the middle of a gap of 0.125
+/// between rim points, one of 4h. (Outside sites alone beyond the rim between spread rim
+/// points, a "fence" a quarter of a rim point's cost, were tried: they bit notches into the
+/// strip, which no inside site was near enough to hold, and a square sheet's normal
+/// consistency fell from 0.981 to 0.958.)
+fn clear_of_rim(rim: &[[f64; 3]], line: &[[f64; 3]], h: f64, points: &[[f64; 3]]) -> Vec<bool> {
+    if rim.is_empty() || line.is_empty() {
+        return vec![true; points.len()];
+    }
+    let kept = soft_voronoi::SiteIndex::new(rim);
+    let tau: Vec<f64> = line.par_iter().map(|&c| kept.nearest(rim, c).1).collect();
+    let reach = tau.iter().copied().fold(0.0, f64::max);
+    let along = soft_voronoi::SiteIndex::new(line);
+    points
+        .par_iter()
+        .map_init(Vec::new, |near, &x| {
+            let a = along.nearest(line, x).1;
+            if a >= reach {
+                return true;
+            }
+            along.candidates(line, x, reach - a, near);
+            near.iter().all(|&(c, d)| d * d + 2.0 * a * h >= tau[c as usize] * tau[c as usize])
+        })
+        .collect()
 }
 
 /// Initial sites for the shell of half-thickness h around `unit`: at Poisson-disk points p
@@ -954,11 +1007,12 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> (Ve
 /// outside sites at p ± 2h·n, whose bisectors are the shell's two sides (exactly, on a flat
 /// part, whatever the spacing); along open boundary edges (meshes welded by position) the
 /// same plus an outside site 2h beyond the edge in the surface's plane, which closes the
-/// band there, and at a rim's corner one more beyond each of its two edges. The points are
-/// spaced by how much the sheet bends ([`shell_layout`]) so that 3 per surface point, 4 per
-/// rim point and 2 per corner make K; labels come from the solid (folds closer than 2h turn
-/// outside sites inside); unused slots are filled with training samples. Returns sites,
-/// labels and the counts of triplets and rim points.
+/// band there, and at a rim's corner one more beyond each of its two edges. The points are spaced by how much the sheet
+/// bends ([`shell_layout`]) within K less a reserve for repairs: triplets where surface
+/// samples are left in a hole. Labels come from the solid; an outside site it holds (within
+/// h of another part of the sheet) is left out. Unused slots are filled with training
+/// samples far from the band. Returns sites, labels and the counts of triplets (repairs
+/// included) and rim points.
 fn shell_sites(
     plan: &ShellPlan,
     surface: &[[f64; 3]],
@@ -969,7 +1023,7 @@ fn shell_sites(
     seed: u64,
 ) -> (Vec<[f64; 3]>, Vec<bool>, (usize, usize)) {
     let h = solid.half_thickness;
-    let (rim, chosen) = shell_layout(plan, surface, h, k - k / SHELL_REPAIR_RESERVE);
+    let Layout { rim, triplets: chosen, clear, .. } = shell_layout(plan, surface, h, k - k / SHELL_REPAIR_RESERVE);
     let rim_points: Vec<RimPoint> = rim.iter().map(|&i| plan.rim[i as usize]).collect();
     // A corner's two edges each get an outside site 2h beyond them as well: the one along
     // the mean direction alone left the band running on past both edges near the corner
@@ -994,7 +1048,21 @@ fn shell_sites(
             sites.extend(edges.map(|d| along(p, d, 2.0 * h)));
         }
     }
-    let mut labels = solid.inside(&sites);
+    let labels = solid.inside(&sites);
+    // An outside site the band holds (by a fold, a wheel arch's turn of the rim: another
+    // part of the sheet within h of it) is left out: labelled inside, with no outside site
+    // beyond it, its cell ran on far from the sheet (libigl's beetle at K = 2,048: a spike
+    // of 13% of the diagonal from one 0.015 from its bottom edge).
+    let centre: Vec<bool> = chosen
+        .iter()
+        .flat_map(|_| [true, false, false])
+        .chain(rim_points.iter().flat_map(|_| [true, false, false, false]))
+        .chain(std::iter::repeat(false))
+        .take(sites.len())
+        .collect();
+    let keep: Vec<bool> = centre.iter().zip(&labels).map(|(&c, &l)| c || !l).collect();
+    sites = sites.iter().zip(&keep).filter(|(_, &k)| k).map(|(p, _)| *p).collect();
+    let mut labels: Vec<bool> = labels.iter().zip(&keep).filter(|(_, &k)| k).map(|(&l, _)| l).collect();
     // Repairs: a surface point whose nearest site is outside lies in a hole through the band
     // (the sheet bends more between triplets than the spacing's measure saw, or two
     // triplets' spacings differ too much); a triplet there closes it. Up to the reserve of K.
@@ -1005,9 +1073,10 @@ fn shell_sites(
             break;
         }
         let index = soft_voronoi::SiteIndex::new(&sites);
+        // Not by the rim (see [`clear_of_rim`]): the rim points' own cells cover it.
         let holes: Vec<usize> = (0..surface.len())
             .into_par_iter()
-            .filter(|&i| !labels[index.nearest(&sites, surface[i]).0 as usize])
+            .filter(|&i| clear[i] && !labels[index.nearest(&sites, surface[i]).0 as usize])
             .collect();
         if holes.is_empty() {
             break;
@@ -1020,7 +1089,13 @@ fn shell_sites(
             let (p, n) = (surface[holes[j as usize]], normals[holes[j as usize]]);
             sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h)]);
         }
-        labels.extend(solid.inside(&sites[start..]));
+        let new = solid.inside(&sites[start..]);
+        let mut j = 0;
+        sites.retain(|_| {
+            j += 1;
+            j <= start || (j - start - 1) % 3 == 0 || !new[j - start - 1]
+        });
+        labels.extend(new.iter().enumerate().filter(|(i, &l)| i % 3 == 0 || !l).map(|(_, &l)| l));
         repaired += fix.len();
     }
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 5);

@@ -236,3 +236,38 @@ fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
     assert!(volume > 0.2 && wall < 0.5 * volume, "Hausdorff as a volume {volume}, as a shell {wall}");
     assert!(!shell.report.summary().contains("--solid shell fits"));
 }
+
+/// A square sheet's band ends about h past its edges and corners: the triplets keep clear
+/// of the rim and each corner has an outside site beyond both its edges. (Before, inside
+/// cells ran on between the rim points' outside sites: 4–5h past a corner.)
+#[test]
+fn a_square_sheets_band_ends_at_its_edges() {
+    let out = fit::fit(&sheet(8), &small("square"), &mut NoProgress).unwrap();
+    let h = out.report.solid.half_thickness.unwrap();
+    // Distance of each crust vertex from the unit square at z = 0.
+    let off = |p: &[f64; 3]| {
+        let dx = (-p[0]).max(p[0] - 1.0).max(0.0);
+        let dy = (-p[1]).max(p[1] - 1.0).max(0.0);
+        (dx * dx + dy * dy + p[2] * p[2]).sqrt()
+    };
+    let far = out.crust.positions.iter().map(off).fold(0.0, f64::max);
+    assert!(far <= 2.0 * h, "a crust vertex {far} from the sheet (h = {h}, {:.2}h)", far / h);
+    assert!(far >= 0.9 * h, "the band is thinner than h: {far} (h = {h})");
+}
+
+/// A hole narrower than the default band is closed by it; the band's genus is then wrong
+/// (0 for a sheet with one hole, whose thin band has genus 1), and a thinner band that
+/// keeps the hole open is taken rather than refused for differing from the default.
+#[test]
+fn a_small_hole_stays_open_in_the_band() {
+    let mut mesh = sheet(20);
+    // Leave out the two triangles of the square cell (10, 10): a hole 0.05 wide.
+    let cell = (10 * 20 + 10) * 2;
+    mesh.triangles.drain(cell..cell + 2);
+    let out = fit::fit(&mesh, &small("holed"), &mut NoProgress).unwrap();
+    let trials = out.report.solid.thickness_search.as_ref().unwrap();
+    assert_eq!(trials[0].genus, Some(0), "the default band closes the hole: {trials:?}");
+    let c = &out.report.crust;
+    assert_eq!((c.num_components, c.genus), (1, Some(1)), "{trials:?}");
+    assert!(out.report.solid.half_thickness_of_diagonal.unwrap() < 0.5 * trials[0].half_thickness_of_diagonal);
+}
