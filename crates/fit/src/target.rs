@@ -825,6 +825,11 @@ struct ShellPlan {
     corner_edges: Vec<[[f64; 3]; 2]>,
     /// Bending around each rim candidate: of the sheet, or of the rim in the sheet's plane.
     rim_bend: Vec<[f64; grading::LEVELS]>,
+    /// The rim candidates' positions, indexed: the rim itself for [`clear_of_rim`].
+    rim_at: Vec<[f64; 3]>,
+    line: Option<soft_voronoi::SiteIndex>,
+    /// Distance of each surface candidate from the rim (its nearest rim candidate).
+    to_rim: Vec<f64>,
 }
 
 impl ShellPlan {
@@ -835,14 +840,14 @@ impl ShellPlan {
         let u = (-b + (b * b + 12.0 * area * k as f64).sqrt()) / (6.0 * area).max(1e-300);
         let s = 1.0 / u.max(1e-300);
         let radii = grading::ladder(2.0 * s);
-        // Rim candidates every eighth of the finest rim spacing along each boundary edge (at
+        // Rim candidates every quarter of the finest rim spacing along each boundary edge (at
         // least one per edge). The rim's corners come first and are always kept: without a
         // point there the band stays open around the corner (the benchmark's sheet grew a
         // spike of 4.6% of the diagonal past a corner at K = 2,048).
         let frames = rim_with_frames(unit, &rim);
         let corners = rim_corners(&frames);
         let mut candidates: Vec<RimPoint> = corners.iter().map(|c| c.0).collect();
-        let step = RIM_SPACING * radii[grading::LEVELS - 1] / 8.0;
+        let step = RIM_SPACING * radii[grading::LEVELS - 1] / 4.0;
         for &(a, b, n, d) in &frames {
             let count = (dist(a, b) / step).ceil().max(1.0) as usize;
             for j in 0..count {
@@ -850,18 +855,29 @@ impl ShellPlan {
                 candidates.push(([0, 1, 2].map(|c| a[c] + t * (b[c] - a[c])), n, d));
             }
         }
-        let surface_bend = grading::spread(surface, &grading::bending(surface, normals, surface, &radii), &radii);
+        // Every fourth candidate as the neighbours measured (the candidates are random and
+        // about 36 to a uniform spacing's square: the same answer at a quarter of the cost).
+        let cloud: Vec<[f64; 3]> = surface.iter().step_by(grading::CLOUD_STRIDE).copied().collect();
+        let surface_bend = grading::spread(surface, &grading::bending(surface, normals, &cloud, &radii), &radii);
         let at: Vec<[f64; 3]> = candidates.iter().map(|c| c.0).collect();
         let (rim_n, rim_d): (Vec<[f64; 3]>, Vec<[f64; 3]>) = candidates.iter().map(|c| (c.1, c.2)).unzip();
-        let sheet = grading::bending(&at, &rim_n, surface, &radii);
+        let sheet = grading::bending(&at, &rim_n, &cloud, &radii);
         let turn = grading::bending(&at, &rim_d, &at, &radii);
         let rim_bend = sheet.iter().zip(&turn).map(|(a, b)| std::array::from_fn(|l| a[l].max(b[l]))).collect();
+        let line = (!at.is_empty()).then(|| soft_voronoi::SiteIndex::new(&at));
+        let to_rim = match &line {
+            Some(index) => surface.par_iter().map(|&x| index.nearest(&at, x).1).collect(),
+            None => vec![f64::INFINITY; surface.len()],
+        };
         ShellPlan {
             radii,
             surface_bend,
             rim: candidates,
             corner_edges: corners.iter().map(|c| c.1).collect(),
             rim_bend,
+            rim_at: at,
+            line,
+            to_rim,
         }
     }
 }
@@ -909,7 +925,7 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> Lay
             spread *= 1.25;
         };
         let kept: Vec<[f64; 3]> = rim.iter().map(|&i| rim_at[i as usize]).collect();
-        let clear = clear_of_rim(&kept, &rim_at, h, surface);
+        let clear = clear_of_rim(&kept, plan, h, surface);
         let ids: Vec<u32> = (0..surface.len() as u32).filter(|&i| clear[i as usize]).collect();
         let pts: Vec<[f64; 3]> = ids.iter().map(|&i| surface[i as usize]).collect();
         let r: Vec<f64> = ids.iter().map(|&i| cap_surface[i as usize].clamp(lo, hi)).collect();
@@ -924,7 +940,7 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> Lay
         // Lower hi (log-bisection) to the densest layout within K.
         let (mut a, mut b) = (finest.ln(), widest.ln());
         best = Some(at_widest);
-        for _ in 0..12 {
+        for _ in 0..9 {
             let mid = 0.5 * (a + b);
             let got = layout(finest, mid.exp());
             if got.total <= k {
@@ -937,7 +953,7 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> Lay
     } else {
         // Too many bends for K: raise lo until it fits (at lo = hi = 2s it always does).
         let (mut a, mut b) = (finest.ln(), widest.ln());
-        for _ in 0..12 {
+        for _ in 0..9 {
             let mid = 0.5 * (a + b);
             let got = layout(mid.exp(), widest);
             if got.total <= k {
@@ -967,9 +983,10 @@ struct Layout {
     clear: Vec<bool>,
 }
 
-/// Which of `points` lie far enough from the rim for a triplet of the band of
-/// half-thickness `h`, given the rim points kept (`rim`) and the rim itself (`line`: points
-/// along it, closer together than the rim points). A point y = c + e·d beyond the rim (c on
+/// Which of the `surface` candidates lie far enough from the rim for a triplet of the band
+/// of half-thickness `h`, given the rim points kept (`rim`) and the rim itself (the plan's
+/// rim candidates, closer together than the rim points, and each candidate's distance from
+/// them). A point y = c + e·d beyond the rim (c on
 /// the rim, d outward) is nearer an inside site x, at distance a from the rim, than the
 /// outside sites 2h beyond the rim points, τ_c from c, when about
 /// |x − c|² + e² + 2a·e < τ_c² + (2h − e)²: x's cell runs on past the band's end (e = h)
@@ -981,22 +998,22 @@ struct Layout {
 /// points, a "fence" a quarter of a rim point's cost, were tried: they bit notches into the
 /// strip, which no inside site was near enough to hold, and a square sheet's normal
 /// consistency fell from 0.981 to 0.958.)
-fn clear_of_rim(rim: &[[f64; 3]], line: &[[f64; 3]], h: f64, points: &[[f64; 3]]) -> Vec<bool> {
-    if rim.is_empty() || line.is_empty() {
-        return vec![true; points.len()];
-    }
+fn clear_of_rim(rim: &[[f64; 3]], plan: &ShellPlan, h: f64, surface: &[[f64; 3]]) -> Vec<bool> {
+    let (Some(along), false) = (&plan.line, rim.is_empty()) else {
+        return vec![true; plan.to_rim.len()];
+    };
+    let line = &plan.rim_at;
     let kept = soft_voronoi::SiteIndex::new(rim);
     let tau: Vec<f64> = line.par_iter().map(|&c| kept.nearest(rim, c).1).collect();
     let reach = tau.iter().copied().fold(0.0, f64::max);
-    let along = soft_voronoi::SiteIndex::new(line);
-    points
+    plan.to_rim
         .par_iter()
-        .map_init(Vec::new, |near, &x| {
-            let a = along.nearest(line, x).1;
+        .enumerate()
+        .map_init(Vec::new, |near, (i, &a)| {
             if a >= reach {
                 return true;
             }
-            along.candidates(line, x, reach - a, near);
+            along.candidates(line, surface[i], reach - a, near);
             near.iter().all(|&(c, d)| d * d + 2.0 * a * h >= tau[c as usize] * tau[c as usize])
         })
         .collect()
@@ -1007,8 +1024,9 @@ fn clear_of_rim(rim: &[[f64; 3]], line: &[[f64; 3]], h: f64, points: &[[f64; 3]]
 /// outside sites at p ± 2h·n, whose bisectors are the shell's two sides (exactly, on a flat
 /// part, whatever the spacing); along open boundary edges (meshes welded by position) the
 /// same plus an outside site 2h beyond the edge in the surface's plane, which closes the
-/// band there, and at a rim's corner one more beyond each of its two edges. The points are spaced by how much the sheet
-/// bends ([`shell_layout`]) within K less a reserve for repairs: triplets where surface
+/// band there, and at a rim's corner one more beyond each of its two edges. The points are
+/// spaced by how much the sheet bends ([`shell_layout`]) within K less a reserve for
+/// repairs: triplets where surface
 /// samples are left in a hole. Labels come from the solid; an outside site it holds (within
 /// h of another part of the sheet) is left out. Unused slots are filled with training
 /// samples far from the band. Returns sites, labels and the counts of triplets (repairs

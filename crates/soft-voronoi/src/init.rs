@@ -389,7 +389,17 @@ pub fn greedy_disk(points: &[[f64; 3]], r: f64) -> Vec<u32> {
 /// [`greedy_disk`] with `seeds` kept before any of `points` (only indices of `points` are
 /// returned).
 pub fn greedy_disk_around(seeds: &[[f64; 3]], points: &[[f64; 3]], r: f64) -> Vec<u32> {
-    let mut grid = DiskGrid::new(r);
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in seeds.iter().chain(points) {
+        for i in 0..3 {
+            lo[i] = lo[i].min(p[i]);
+            hi[i] = hi[i].max(p[i]);
+        }
+    }
+    if lo[0] > hi[0] {
+        return Vec::new();
+    }
+    let mut grid = DiskGrid::within(r, lo, hi);
     seeds.iter().for_each(|&p| grid.insert(p));
     let mut kept = Vec::new();
     for (i, &p) in points.iter().enumerate() {
@@ -404,7 +414,10 @@ pub fn greedy_disk_around(seeds: &[[f64; 3]], points: &[[f64; 3]], r: f64) -> Ve
 /// Points in the unit cube bucketed in a uniform grid of cells of side ≥ r, so every point
 /// within r of a query lies in one of the 27 cells around it.
 struct DiskGrid {
-    m: usize,
+    /// Cells along each axis, over [lo, lo + extent].
+    m: [usize; 3],
+    lo: [f64; 3],
+    extent: [f64; 3],
     r2: f64,
     head: Vec<u32>,
     next: Vec<u32>,
@@ -413,16 +426,28 @@ struct DiskGrid {
 
 impl DiskGrid {
     fn new(r: f64) -> Self {
-        let m = ((1.0 / r).floor() as usize).clamp(1, 256);
-        DiskGrid { m, r2: r * r, head: vec![u32::MAX; m * m * m], next: Vec::new(), placed: Vec::new() }
+        DiskGrid::within(r, [0.0; 3], [1.0; 3])
+    }
+
+    /// A grid over the box [lo, hi] only (points outside fall in its border cells): a thin
+    /// shell's rim or a flat sheet fills a sliver of the unit cube, and a grid of the whole
+    /// cube at a small r cost 67 MB to clear per pass (most of a shell's layout time).
+    fn within(r: f64, lo: [f64; 3], hi: [f64; 3]) -> Self {
+        let extent = [0, 1, 2].map(|i| (hi[i] - lo[i]).max(0.0));
+        let m = extent.map(|e| ((e / r).floor() as usize).clamp(1, 256));
+        let cells = m[0] * m[1] * m[2];
+        DiskGrid { m, lo, extent, r2: r * r, head: vec![u32::MAX; cells], next: Vec::new(), placed: Vec::new() }
     }
 
     fn cell(&self, p: [f64; 3]) -> [isize; 3] {
-        p.map(|x| ((x * self.m as f64) as isize).clamp(0, self.m as isize - 1))
+        [0, 1, 2].map(|i| {
+            let t = if self.extent[i] > 0.0 { (p[i] - self.lo[i]) / self.extent[i] } else { 0.0 };
+            ((t * self.m[i] as f64) as isize).clamp(0, self.m[i] as isize - 1)
+        })
     }
 
     fn slot(&self, c: [isize; 3]) -> usize {
-        (c[0] as usize * self.m + c[1] as usize) * self.m + c[2] as usize
+        (c[0] as usize * self.m[1] + c[1] as usize) * self.m[2] + c[2] as usize
     }
 
     fn insert(&mut self, p: [f64; 3]) {
@@ -445,7 +470,7 @@ impl DiskGrid {
             for dy in -1..=1isize {
                 for dz in -1..=1isize {
                     let q = [c[0] + dx, c[1] + dy, c[2] + dz];
-                    if q.iter().any(|&x| x < 0 || x >= self.m as isize) {
+                    if (0..3).any(|i| q[i] < 0 || q[i] >= self.m[i] as isize) {
                         continue;
                     }
                     let mut j = self.head[self.slot(q)];
