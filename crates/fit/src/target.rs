@@ -891,16 +891,17 @@ impl ShellPlan {
 /// bends need more than K even so, lo is raised instead (the band's thinnest parts then
 /// rest on fewer triplets than they need, and the band's check will tell). Rim points lie
 /// at [`RIM_SPACING`] times the spacing (at most that of the uniform spacing s), spread
-/// wider where the rim would take more than a third of K. The triplets keep their spacing from the rim points and stay [`clear_of_rim`]: an inside
-/// site nearer the rim than the rim points are to each other has a cell running on beyond
-/// the rim, between the rim points' outside sites (the sheets' farthest crust points were
-/// there: libigl's grid.off 3.3h beyond its edges by each corner).
+/// wider where the rim would take more than a third of K. The triplets keep their spacing
+/// from the rim points and stay [`clear_of_rim`]: an inside site nearer the rim than the
+/// rim points are to each other has a cell running on beyond the rim, between the rim
+/// points' outside sites (the sheets' farthest crust points were there: libigl's grid.off
+/// 3.3h beyond its edges by each corner).
 fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> Layout {
     let limit = grading::BEND_SHARE * h;
     let radii = &plan.radii;
     let cap_surface: Vec<f64> = plan.surface_bend.iter().map(|b| grading::widest_flat(b, radii, limit)).collect();
     let cap_rim: Vec<f64> = plan.rim_bend.iter().map(|b| grading::widest_flat(b, radii, limit)).collect();
-    let rim_at: Vec<[f64; 3]> = plan.rim.iter().map(|c| c.0).collect();
+    let rim_at = &plan.rim_at;
     let corners = plan.corner_edges.len();
     let layout = |lo: f64, hi: f64| -> Layout {
         let mut spread = 1.0;
@@ -935,33 +936,19 @@ fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: usize) -> Lay
     };
     let (finest, widest) = (radii[grading::LEVELS - 1], radii[0]);
     let at_widest = layout(finest, widest);
-    let mut best = None;
-    if at_widest.total <= k {
-        // Lower hi (log-bisection) to the densest layout within K.
-        let (mut a, mut b) = (finest.ln(), widest.ln());
-        best = Some(at_widest);
-        for _ in 0..9 {
-            let mid = 0.5 * (a + b);
-            let got = layout(finest, mid.exp());
-            if got.total <= k {
-                b = mid;
-                best = Some(got);
-            } else {
-                a = mid;
-            }
-        }
-    } else {
-        // Too many bends for K: raise lo until it fits (at lo = hi = 2s it always does).
-        let (mut a, mut b) = (finest.ln(), widest.ln());
-        for _ in 0..9 {
-            let mid = 0.5 * (a + b);
-            let got = layout(mid.exp(), widest);
-            if got.total <= k {
-                b = mid;
-                best = Some(got);
-            } else {
-                a = mid;
-            }
+    // Within K at the widest spacing: lower hi (log-bisection) to the densest layout within
+    // K. Too many bends for K: raise lo until it fits (at lo = hi = 2s it always does).
+    let fits = at_widest.total <= k;
+    let mut best = fits.then_some(at_widest);
+    let (mut a, mut b) = (finest.ln(), widest.ln());
+    for _ in 0..9 {
+        let mid = 0.5 * (a + b);
+        let got = if fits { layout(finest, mid.exp()) } else { layout(mid.exp(), widest) };
+        if got.total <= k {
+            b = mid;
+            best = Some(got);
+        } else {
+            a = mid;
         }
     }
     let Layout { mut rim, mut triplets, clear, .. } = best.unwrap_or_else(|| layout(widest, widest));
@@ -986,9 +973,9 @@ struct Layout {
 /// Which of the `surface` candidates lie far enough from the rim for a triplet of the band
 /// of half-thickness `h`, given the rim points kept (`rim`) and the rim itself (the plan's
 /// rim candidates, closer together than the rim points, and each candidate's distance from
-/// them). A point y = c + e·d beyond the rim (c on
-/// the rim, d outward) is nearer an inside site x, at distance a from the rim, than the
-/// outside sites 2h beyond the rim points, τ_c from c, when about
+/// them). A point y = c + e·d beyond the rim (c on the rim, d outward) is nearer an inside
+/// site x, at distance a from the rim, than the outside sites 2h beyond the rim points, τ_c
+/// from c, when about
 /// |x − c|² + e² + 2a·e < τ_c² + (2h − e)²: x's cell runs on past the band's end (e = h)
 /// unless |x − c|² + 2a·h ≥ τ_c² for every c. Points for which that fails are not clear;
 /// the rim points' own cells cover them. A repair triplet 0.003 from the bottom edge of
@@ -1026,10 +1013,9 @@ fn clear_of_rim(rim: &[[f64; 3]], plan: &ShellPlan, h: f64, surface: &[[f64; 3]]
 /// same plus an outside site 2h beyond the edge in the surface's plane, which closes the
 /// band there, and at a rim's corner one more beyond each of its two edges. The points are
 /// spaced by how much the sheet bends ([`shell_layout`]) within K less a reserve for
-/// repairs: triplets where surface
-/// samples are left in a hole. Labels come from the solid; an outside site it holds (within
-/// h of another part of the sheet) is left out. Unused slots are filled with training
-/// samples far from the band. Returns sites, labels and the counts of triplets (repairs
+/// repairs: triplets where surface samples are left in a hole. Labels come from the solid;
+/// an outside site it holds is left out ([`append_unless_held`]). Unused slots are filled
+/// with training samples far from the band. Returns sites, labels and the counts of triplets (repairs
 /// included) and rim points.
 fn shell_sites(
     plan: &ShellPlan,
@@ -1053,34 +1039,25 @@ fn shell_sites(
         .collect();
     let clamp = |p: [f64; 3]| p.map(|x| x.clamp(1e-6, 1.0 - 1e-6));
     let along = |p: [f64; 3], v: [f64; 3], f: f64| clamp([0, 1, 2].map(|c| p[c] + f * v[c]));
-    let mut sites = Vec::with_capacity(k);
+    let triplet = |p: [f64; 3], n: [f64; 3]| [clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h)];
+    let (mut new, mut centre) = (Vec::with_capacity(k), Vec::with_capacity(k));
     for &i in &chosen {
-        let (p, n) = (surface[i as usize], normals[i as usize]);
-        sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h)]);
+        new.extend(triplet(surface[i as usize], normals[i as usize]));
+        centre.extend([true, false, false]);
     }
     for &(p, n, d) in &rim_points {
-        sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h), along(p, d, 2.0 * h)]);
+        new.extend(triplet(p, n));
+        new.push(along(p, d, 2.0 * h));
+        centre.extend([true, false, false, false]);
     }
     for &(p, edges) in &corner_edges {
-        if sites.len() + 2 <= k {
-            sites.extend(edges.map(|d| along(p, d, 2.0 * h)));
+        if new.len() + 2 <= k {
+            new.extend(edges.map(|d| along(p, d, 2.0 * h)));
+            centre.extend([false, false]);
         }
     }
-    let labels = solid.inside(&sites);
-    // An outside site the band holds (by a fold, a wheel arch's turn of the rim: another
-    // part of the sheet within h of it) is left out: labelled inside, with no outside site
-    // beyond it, its cell ran on far from the sheet (libigl's beetle at K = 2,048: a spike
-    // of 13% of the diagonal from one 0.015 from its bottom edge).
-    let centre: Vec<bool> = chosen
-        .iter()
-        .flat_map(|_| [true, false, false])
-        .chain(rim_points.iter().flat_map(|_| [true, false, false, false]))
-        .chain(std::iter::repeat(false))
-        .take(sites.len())
-        .collect();
-    let keep: Vec<bool> = centre.iter().zip(&labels).map(|(&c, &l)| c || !l).collect();
-    sites = sites.iter().zip(&keep).filter(|(_, &k)| k).map(|(p, _)| *p).collect();
-    let mut labels: Vec<bool> = labels.iter().zip(&keep).filter(|(_, &k)| k).map(|(&l, _)| l).collect();
+    let (mut sites, mut labels) = (Vec::with_capacity(k), Vec::with_capacity(k));
+    append_unless_held(&mut sites, &mut labels, &new, &centre, solid);
     // Repairs: a surface point whose nearest site is outside lies in a hole through the band
     // (the sheet bends more between triplets than the spacing's measure saw, or two
     // triplets' spacings differ too much); a triplet there closes it. Up to the reserve of K.
@@ -1102,27 +1079,18 @@ fn shell_sites(
         let at: Vec<[f64; 3]> = holes.iter().map(|&i| surface[i]).collect();
         let mut fix = greedy_disk(&at, plan.radii[grading::LEVELS - 1]);
         fix.truncate(room);
-        let start = sites.len();
-        for &j in &fix {
-            let (p, n) = (surface[holes[j as usize]], normals[holes[j as usize]]);
-            sites.extend([clamp(p), along(p, n, 2.0 * h), along(p, n, -2.0 * h)]);
-        }
-        let new = solid.inside(&sites[start..]);
-        let mut j = 0;
-        sites.retain(|_| {
-            j += 1;
-            j <= start || (j - start - 1) % 3 == 0 || !new[j - start - 1]
-        });
-        labels.extend(new.iter().enumerate().filter(|(i, &l)| i % 3 == 0 || !l).map(|(_, &l)| l));
+        let new: Vec<[f64; 3]> =
+            fix.iter().flat_map(|&j| triplet(surface[holes[j as usize]], normals[holes[j as usize]])).collect();
+        let centre: Vec<bool> = fix.iter().flat_map(|_| [true, false, false]).collect();
+        append_unless_held(&mut sites, &mut labels, &new, &centre, solid);
         repaired += fix.len();
     }
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 5);
     // The slots the triplets, rim points and repairs leave (up to the unused repair reserve)
     // get pool points outside the band and far from it, labelled outside: they only split
-    // empty space. A pool point
-    // inside the band, off the triplets' lines, put a speck in the flat crust of libigl's
-    // grid.off (the one fill site, 0.0015 from the sheet); a point that close outside would
-    // dent it. Points elsewhere (labelled by the band) only if the pool has none so far.
+    // empty space. A pool point inside the band, off the triplets' lines, put a speck in the
+    // flat crust of libigl's grid.off (the one fill site, 0.0015 from the sheet); a point
+    // that close outside would dent it. Points elsewhere (labelled by the band) only if the pool has none so far.
     let missing = k.saturating_sub(sites.len());
     // Farther from the band than the widest spacing between triplet centres, so no sheet
     // point is nearer a fill site than its nearest centre (at 2h only, fill sites punched
@@ -1157,6 +1125,27 @@ const SHELL_REPAIR_RESERVE: usize = 8;
 
 /// Rounds of hole repair in a shell's sites.
 const SHELL_REPAIR_ROUNDS: usize = 6;
+
+/// Appends `new` sites with their labels by `solid`, leaving out every one that is not a
+/// triplet's or rim point's centre (`centre`) yet lies inside the band: an outside site the
+/// band holds (by a fold, a wheel arch's turn of the rim: another part of the sheet within
+/// h of it), labelled inside with no outside site beyond it, has a cell running on far from
+/// the sheet (libigl's beetle at K = 2,048: a spike of 13% of the diagonal from one 0.015
+/// from its bottom edge).
+fn append_unless_held(
+    sites: &mut Vec<[f64; 3]>,
+    labels: &mut Vec<bool>,
+    new: &[[f64; 3]],
+    centre: &[bool],
+    solid: &ShellSolid,
+) {
+    for ((&p, &c), l) in new.iter().zip(centre).zip(solid.inside(new)) {
+        if c || !l {
+            sites.push(p);
+            labels.push(l);
+        }
+    }
+}
 
 /// A boundary edge (a, b) with its triangle's unit normal and the unit direction across the
 /// edge, away from the triangle, in its plane.
