@@ -1154,11 +1154,15 @@ type RimEdge = ([f64; 3], [f64; 3], [f64; 3], [f64; 3]);
 /// A rim point with its normal and outward direction (as [`RimEdge`]'s).
 type RimPoint = ([f64; 3], [f64; 3], [f64; 3]);
 
+/// A rim corner as a [`RimPoint`] (the mean of its edges' frames) with each of its two
+/// edges' outward directions.
+type Corner = (RimPoint, [[f64; 3]; 2]);
+
 /// The corners of a rim given as edges with frames (from [`rim_with_frames`]): boundary
 /// vertices (by position) with exactly two boundary edges that meet at an angle below 150°
 /// (a straight rim: 180°), each with the mean of its edges' normals and of their outward
 /// directions (unit), sorted by position so the order does not depend on hashing.
-fn rim_corners(frames: &[RimEdge]) -> Vec<(RimPoint, [[f64; 3]; 2])> {
+fn rim_corners(frames: &[RimEdge]) -> Vec<Corner> {
     let mut at: HashMap<[u64; 3], Vec<(usize, [f64; 3])>> = HashMap::new();
     for (i, &(a, b, _, _)) in frames.iter().enumerate() {
         at.entry(a.map(f64::to_bits)).or_default().push((i, b));
@@ -1168,7 +1172,7 @@ fn rim_corners(frames: &[RimEdge]) -> Vec<(RimPoint, [[f64; 3]; 2])> {
         let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         (l > 0.0).then(|| v.map(|x| x / l))
     };
-    let mut corners: Vec<([u64; 3], (RimPoint, [[f64; 3]; 2]))> = Vec::new();
+    let mut corners: Vec<([u64; 3], Corner)> = Vec::new();
     for (key, ends) in &at {
         let [(e, p), (f, q)] = ends[..] else { continue };
         let v = key.map(f64::from_bits);
