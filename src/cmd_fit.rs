@@ -148,8 +148,14 @@ pub struct Args {
     /// √(8192/K); halved four times over the steps).
     #[arg(long)]
     pub polish_lr: Option<f64>,
+    /// Weight of the polish's alignment term over its first half (nearest inside and
+    /// outside sites of each surface sample turned along its normal, which lines the pairs
+    /// up, for smoother normals on smooth shapes; default: off, VoroLoss alone, as VoroMesh;
+    /// e.g. 0.3; README, *Lined-up pairs*).
+    #[arg(long)]
+    pub polish_align: Option<f64>,
     /// No surface polish after training.
-    #[arg(long, conflicts_with_all = ["polish_steps", "polish_lr"])]
+    #[arg(long, conflicts_with_all = ["polish_steps", "polish_lr", "polish_align"])]
     pub no_polish: bool,
     /// Budget of sites for --target-hausdorff.
     #[arg(long, default_value_t = 131_072)]
@@ -235,6 +241,7 @@ fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
         no_polish: args.no_polish,
         polish_steps: args.polish_steps,
         polish_lr: args.polish_lr,
+        polish_align: args.polish_align,
     };
     let mut c = options.to_config(&args.mesh.display().to_string())?;
     c.checkpointing = Some(Checkpointing { path: out.checkpoint.clone(), every: args.checkpoint_every });

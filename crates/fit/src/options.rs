@@ -67,6 +67,9 @@ pub struct FitOptions {
     pub polish_steps: Option<usize>,
     /// Polish learning rate (default 1e-3 at K = 8,192, scaled by √(8192/K)).
     pub polish_lr: Option<f64>,
+    /// Weight of the polish's alignment term (`soft_voronoi::polish::Alignment`; default
+    /// none, VoroLoss alone; 0.3 measured on smooth shapes).
+    pub polish_align: Option<f64>,
 }
 
 impl FitOptions {
@@ -116,6 +119,10 @@ impl FitOptions {
             let mut p = soft_voronoi::PolishConfig::default_for(k, self.seed);
             p.steps = self.polish_steps.unwrap_or(p.steps);
             p.lr = self.polish_lr.unwrap_or(p.lr);
+            if let Some(w) = self.polish_align {
+                p.alignment =
+                    (w > 0.0).then(|| soft_voronoi::polish::Alignment { normal_weight: w, ..Default::default() });
+            }
             (p.steps > 0).then_some(p)
         };
         if c.polish.is_some() && self.no_relabel {

@@ -144,88 +144,109 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     let trainer = train(&data, solid, initial, config, progress)?;
     timings.train = lap.next();
 
-    progress.stage(Stage::Polish);
-    let (mut sites, mut labels, num_projected) = trainer.final_sites();
-    let polish = match &config.polish {
-        Some(pc) if !target.places_sites() => {
-            // Cap samples add to each batch instead of taking from the input's share, so the
-            // input's faces are pulled as often as without caps; at most twice the batch,
-            // which bounds the polish's time where the caps outweigh the input (an open
-            // pipe's lids; libigl's halftunnel, caps a third of the crust, takes 1.4 times).
-            let mut pc = pc.clone();
-            let input = data.surface.len().saturating_sub(solid_report.cap_samples).max(1);
-            pc.batch = pc.batch * data.surface.len().min(2 * input) / input;
-            Some(polish(&mut sites, &data, &trainer, &pc, config, progress)?)
-        }
-        _ => None,
-    };
-    timings.polish = lap.next();
-
-    progress.stage(Stage::Crust);
-    let num_relabelled =
-        if config.relabel { relabel(&sites, &mut labels, trainer.config().num_sites, solid) } else { 0 };
-    // Not on a thin shell kept as constructed: its sides are the triplets' bisectors
-    // already, and a carving pair (offset 0.3% of the diagonal) across a band thinner than
-    // that has both sites outside and punches a hole in it (libigl's lilium at a
-    // half-thickness of 0.24%: genus 0 → 260). At the default band no round was kept.
-    let carve = if target.places_sites() && !config.train_shell { None } else { config.carve };
-    // With carving: no crust outside the input's bounding box (not on a thin shell, whose
-    // solid reaches past the surface by its half-thickness). The guard runs before carving,
-    // so that carving judges the crust as it will be written (a farthest crust vertex past
-    // the box is the guard's to cut: on the thin plate at K = 8,192 a round that traded
-    // one for a dent was kept, Hausdorff 0.25 → 0.36%), and again after carving's kept
-    // rounds, whose cells may run past the box.
-    let guard_box = match config.carve {
-        Some(c) if !target.places_sites() => {
-            let (lo, hi) = p.unit.bounding_box();
-            Some((lo, hi, c * diagonal))
-        }
-        _ => None,
-    };
-    let mut guard = match guard_box {
-        Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
-        None => None,
-    };
-    // Carving's mirrors can leave Voronoi features finer than the output's precision holds
-    // (on snowden, a thin-walled shell, at K = 8,192: float32 rounding broke the crust
-    // beyond repair); then carving runs again from the same sites without them.
-    let before_carving = carve.map(|_| (sites.clone(), labels.clone(), guard.clone()));
-    let mut mirrors = true;
-    let mut dropped = None;
-    let (carving, pruning, checked) = loop {
-        let carving = match carve {
-            Some(c) => {
-                let k = trainer.config().num_sites;
-                let tolerance = c * diagonal;
-                let options =
-                    crate::carve::CarveOptions { mirrors, ..crate::carve::CarveOptions::for_sites(tolerance, k) };
-                let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, &options)?;
-                r.tolerance_of_diagonal = c;
-                r.mirrors_dropped = dropped.take();
-                Some(r)
+    // The polish's alignment term lines pairs up, and lined-up pairs are nearly cospherical:
+    // their crust has Voronoi vertices that nearly coincide. Should the crust then not
+    // survive rounding to the output's precision, everything from the polish on runs again
+    // without the term (the report's `polish.alignment_dropped`).
+    let mut aligned = config.polish.as_ref().is_some_and(|pc| pc.alignment.is_some());
+    let mut alignment_dropped = None;
+    let (sites, labels, num_projected, mut polish, num_relabelled, guard, carving, pruning, checked) = 'attempt: loop {
+        progress.stage(Stage::Polish);
+        let (mut sites, mut labels, num_projected) = trainer.final_sites();
+        let polish = match &config.polish {
+            Some(pc) if !target.places_sites() => {
+                // Cap samples add to each batch instead of taking from the input's share, so the
+                // input's faces are pulled as often as without caps; at most twice the batch,
+                // which bounds the polish's time where the caps outweigh the input (an open
+                // pipe's lids; libigl's halftunnel, caps a third of the crust, takes 1.4 times).
+                let mut pc = pc.clone();
+                let input = data.surface.len().saturating_sub(solid_report.cap_samples).max(1);
+                pc.batch = pc.batch * data.surface.len().min(2 * input) / input;
+                if !aligned {
+                    pc.alignment = None;
+                }
+                Some(polish(&mut sites, &data, &trainer, &pc, config, progress)?)
             }
+            _ => None,
+        };
+        timings.polish += lap.next();
+
+        progress.stage(Stage::Crust);
+        let num_relabelled =
+            if config.relabel { relabel(&sites, &mut labels, trainer.config().num_sites, solid) } else { 0 };
+        // Not on a thin shell kept as constructed: its sides are the triplets' bisectors
+        // already, and a carving pair (offset 0.3% of the diagonal) across a band thinner than
+        // that has both sites outside and punches a hole in it (libigl's lilium at a
+        // half-thickness of 0.24%: genus 0 → 260). At the default band no round was kept.
+        let carve = if target.places_sites() && !config.train_shell { None } else { config.carve };
+        // With carving: no crust outside the input's bounding box (not on a thin shell, whose
+        // solid reaches past the surface by its half-thickness). The guard runs before carving,
+        // so that carving judges the crust as it will be written (a farthest crust vertex past
+        // the box is the guard's to cut: on the thin plate at K = 8,192 a round that traded
+        // one for a dent was kept, Hausdorff 0.25 → 0.36%), and again after carving's kept
+        // rounds, whose cells may run past the box.
+        let guard_box = match config.carve {
+            Some(c) if !target.places_sites() => {
+                let (lo, hi) = p.unit.bounding_box();
+                Some((lo, hi, c * diagonal))
+            }
+            _ => None,
+        };
+        let mut guard = match guard_box {
+            Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
             None => None,
         };
-        if let (Some(g), Some((lo, hi, threshold)), Some(r)) = (guard.as_mut(), guard_box, carving.as_ref()) {
-            if !r.inserted_per_round.is_empty() {
-                g.after_carving(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?);
+        // Carving's mirrors can leave Voronoi features finer than the output's precision holds
+        // (on snowden, a thin-walled shell, at K = 8,192: float32 rounding broke the crust
+        // beyond repair); then carving runs again from the same sites without them.
+        let before_carving = carve.map(|_| (sites.clone(), labels.clone(), guard.clone()));
+        let mut mirrors = true;
+        let mut dropped = None;
+        let (carving, pruning, checked) = loop {
+            let carving = match carve {
+                Some(c) => {
+                    let k = trainer.config().num_sites;
+                    let tolerance = c * diagonal;
+                    let options =
+                        crate::carve::CarveOptions { mirrors, ..crate::carve::CarveOptions::for_sites(tolerance, k) };
+                    let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, &options)?;
+                    r.tolerance_of_diagonal = c;
+                    r.mirrors_dropped = dropped.take();
+                    Some(r)
+                }
+                None => None,
+            };
+            if let (Some(g), Some((lo, hi, threshold)), Some(r)) = (guard.as_mut(), guard_box, carving.as_ref()) {
+                if !r.inserted_per_round.is_empty() {
+                    g.after_carving(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?);
+                }
             }
-        }
-        let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
-        let mirrored = carving.as_ref().is_some_and(|r| r.inserted_as_mirrors_per_round.iter().sum::<usize>() > 0);
-        match crust_of(&sites, &labels, &p.transform, config.output_precision) {
-            Ok(checked) => break (carving, pruning, checked),
-            Err(FitError::Input(e)) if mirrored => {
-                let Some((s, l, g)) = before_carving.clone() else { return Err(FitError::Input(e)) };
-                (sites, labels, guard) = (s, l, g);
-                mirrors = false;
-                dropped = Some(e);
+            let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
+            let mirrored = carving.as_ref().is_some_and(|r| r.inserted_as_mirrors_per_round.iter().sum::<usize>() > 0);
+            match crust_of(&sites, &labels, &p.transform, config.output_precision) {
+                Ok(checked) => break (carving, pruning, checked),
+                Err(FitError::Input(e)) if mirrored => {
+                    let Some((s, l, g)) = before_carving.clone() else { return Err(FitError::Input(e)) };
+                    (sites, labels, guard) = (s, l, g);
+                    mirrors = false;
+                    dropped = Some(e);
+                }
+                Err(FitError::Input(e)) if aligned => {
+                    aligned = false;
+                    alignment_dropped = Some(e);
+                    timings.crust += lap.next();
+                    continue 'attempt;
+                }
+                Err(e) => return Err(e),
             }
-            Err(e) => return Err(e),
-        }
+        };
+        break (sites, labels, num_projected, polish, num_relabelled, guard, carving, pruning, checked);
     };
+    if let Some(p) = polish.as_mut() {
+        p.alignment_dropped = alignment_dropped;
+    }
     let crust_mesh = checked.written.mesh.clone();
-    timings.crust = lap.next();
+    timings.crust += lap.next();
 
     progress.stage(Stage::Evaluate);
     let quality = misclassification(&sampler, solid, &sites, &labels, config, diagonal)?;
@@ -345,11 +366,19 @@ fn polish(
 ) -> Result<soft_voronoi::PolishReport, FitError> {
     let k = trainer.config().num_sites;
     let mut stopped = false;
-    let report = soft_voronoi::polish::polish(sites, k, &data.surface, pc, |done, total, loss| {
-        progress.polish_step(done, total, loss);
-        stopped = progress.should_stop() && done < total;
-        !stopped
-    })
+    let (_, labels, _) = trainer.final_sites();
+    let report = soft_voronoi::polish::polish(
+        sites,
+        k,
+        &data.surface,
+        Some((&labels, &data.normals)),
+        pc,
+        |done, total, loss| {
+            progress.polish_step(done, total, loss);
+            stopped = progress.should_stop() && done < total;
+            !stopped
+        },
+    )
     .map_err(|e| FitError::Failure(e.to_string()))?;
     if stopped {
         let steps = trainer.config().steps;

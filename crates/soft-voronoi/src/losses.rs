@@ -359,7 +359,7 @@ pub fn surface(
     grad: &mut [[f64; 3]],
 ) -> f64 {
     let mut hints = vec![[NO_HINT; 2]; points.len()];
-    surface_hinted(index, sites, points, normals, &mut hints, normal_weight, weight, grad)
+    surface_hinted(index, sites, points, normals, &mut hints, normal_weight, 0.0, weight, grad)
 }
 
 /// [`surface`] warm-started: `hints` holds, per point, an inside and an outside site that
@@ -373,6 +373,7 @@ pub fn surface_hinted(
     normals: &[[f64; 3]],
     hints: &mut [[u32; 2]],
     normal_weight: f64,
+    min_cos: f64,
     weight: f64,
     grad: &mut [[f64; 3]],
 ) -> f64 {
@@ -400,9 +401,9 @@ pub fn surface_hinted(
                 let f = 2.0 * d / len;
                 let mut ga = [0, 1, 2].map(|c| f * (-0.5 * e[c] - r[c] + d * e[c] / len));
                 let mut gb = [0, 1, 2].map(|c| f * (-0.5 * e[c] + r[c] - d * e[c] / len));
-                if normal_weight > 0.0 {
+                let un = (e[0] * nx[0] + e[1] * nx[1] + e[2] * nx[2]) / len;
+                if normal_weight > 0.0 && un.abs() >= min_cos {
                     // 1 − (u·n)²; ∂(u·n)/∂e = (n − (u·n) u)/|e|, ∂e/∂b = I = −∂e/∂a.
-                    let un = (e[0] * nx[0] + e[1] * nx[1] + e[2] * nx[2]) / len;
                     loss += normal_weight * (1.0 - un * un);
                     let g = -2.0 * normal_weight * un / len;
                     for c in 0..3 {

@@ -549,6 +549,7 @@ fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, hints: &mut Hin
             batch.normals,
             &mut hints.surface,
             w.normal,
+            0.0,
             w.surface,
             grad,
         ),

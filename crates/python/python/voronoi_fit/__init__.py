@@ -67,6 +67,7 @@ _FIT_OPTIONS = {
     "skip_metrics",
     "polish_steps",
     "polish_lr",
+    "polish_align",
 }
 
 
@@ -287,7 +288,7 @@ def fit(
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics,
-            polish_steps (0: no polish), polish_lr.
+            polish_steps (0: no polish), polish_lr, polish_align (0: VoroLoss alone).
 
     Returns:
         :class:`FitResult`.

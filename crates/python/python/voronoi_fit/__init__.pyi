@@ -63,6 +63,7 @@ def fit(
     skip_metrics: Optional[bool] = None,
     polish_steps: Optional[int] = None,
     polish_lr: Optional[float] = None,
+    polish_align: Optional[float] = None,
 ) -> FitResult: ...
 def save_mesh(path: Union[str, os.PathLike[str]], vertices: npt.ArrayLike, faces: npt.ArrayLike) -> None: ...
 def crust(
