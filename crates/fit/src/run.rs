@@ -165,7 +165,7 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
                 if !aligned {
                     pc.alignment = None;
                 }
-                Some(polish(&mut sites, &data, &trainer, &pc, config, progress)?)
+                Some(polish(&mut sites, &labels, &data, &trainer, &pc, config, progress)?)
             }
             _ => None,
         };
@@ -355,9 +355,11 @@ fn train<'a>(
 
 /// Polishes the trained sites onto the surface samples ([`soft_voronoi::polish`]). A stop
 /// asked for during the polish writes the finished training's checkpoint (when
-/// checkpointing), so a resume redoes only the polish.
+/// checkpointing), so a resume redoes only the polish. `labels` are the sites' labels,
+/// for the alignment term.
 fn polish(
     sites: &mut [[f64; 3]],
+    labels: &[bool],
     data: &TrainingData,
     trainer: &Trainer,
     pc: &soft_voronoi::PolishConfig,
@@ -366,12 +368,11 @@ fn polish(
 ) -> Result<soft_voronoi::PolishReport, FitError> {
     let k = trainer.config().num_sites;
     let mut stopped = false;
-    let (_, labels, _) = trainer.final_sites();
     let report = soft_voronoi::polish::polish(
         sites,
         k,
         &data.surface,
-        Some((&labels, &data.normals)),
+        Some((labels, &data.normals)),
         pc,
         |done, total, loss| {
             progress.polish_step(done, total, loss);
