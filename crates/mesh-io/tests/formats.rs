@@ -62,6 +62,24 @@ fn obj_negative_indices_and_missing_mtl() {
     assert_eq!(read_mesh(&p).unwrap().triangles, vec![[0, 1, 2]]);
 }
 
+/// A backslash at the end of a line continues it (the OBJ format; trimesh's `wallhole.obj`
+/// splits long faces so, with CRLF endings). Lines after a joined one keep their numbers in
+/// errors, and a comment ending in a backslash does not swallow the next line. A `usemtl`
+/// without a name (the same file) does not matter: materials are not read.
+#[test]
+fn obj_lines_continued_by_a_backslash_are_joined() {
+    let d = tmp();
+    let quad = b"mtllib 00.mtl\r\nusemtl \r\nv 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\n# C:\\models\\\r\nv 0 1 0\r\nf 1 2 \\\r\n3 4\r\n";
+    let p = write(d.path(), "c.obj", quad);
+    assert_eq!(read_mesh(&p).unwrap().triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    let p = write(d.path(), "lf.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 \\\n 2 \\\n 3\n");
+    assert_eq!(read_mesh(&p).unwrap().triangles, vec![[0, 1, 2]]);
+    // Line 6 refers to a vertex that does not exist: the joined lines 4–5 do not shift it.
+    let p = write(d.path(), "bad.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n3\nf 1 2 9\n");
+    let e = read_mesh(&p).unwrap_err();
+    assert_eq!((e.kind, &e.location), (ErrorKind::IndexOutOfRange, &Location::Line(6)), "{e}");
+}
+
 #[test]
 fn every_writer_round_trips_an_icosphere() {
     let d = tmp();

@@ -12,6 +12,8 @@ use crate::error::{ErrorKind, Location, MeshError, Result};
 use crate::TriMesh;
 
 pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
+    let joined = prepare_text(bytes);
+    let bytes: &[u8] = &joined;
     let options = tobj::LoadOptions { single_index: false, triangulate: true, ignore_points: true, ignore_lines: true };
     let mut reader = std::io::BufReader::new(bytes);
     // Materials are irrelevant to geometry: a missing .mtl must not fail the load.
@@ -63,6 +65,56 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
         ));
     }
     Ok(mesh)
+}
+
+/// The text tobj is given, line for line the file's (so error messages keep their line
+/// numbers):
+/// - The OBJ format lets a line go on after a backslash at its end (trimesh's
+///   `wallhole.obj` splits long faces so, with CRLF endings); tobj reads each physical line
+///   on its own and would take the backslash for a corner. Continued lines are joined into
+///   their first, and the lines taken out come back as empty lines after it (an error in a
+///   joined line names its first line). Comment lines are left alone: a path ending in a
+///   backslash must not swallow the next line.
+/// - `mtllib` and `usemtl` lines become empty: materials are irrelevant to the geometry,
+///   and tobj refuses a `usemtl` without a name (the same file, written by Rhino).
+///
+/// Borrowed when there is nothing to change.
+fn prepare_text(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    let lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
+    let body = |l: &[u8]| -> usize { l.len() - usize::from(l.ends_with(b"\r")) };
+    let comment = |l: &[u8]| l.trim_ascii_start().starts_with(b"#");
+    let material = |l: &[u8]| {
+        let t = l.trim_ascii_start();
+        (t.starts_with(b"usemtl") || t.starts_with(b"mtllib"))
+            && t.get(6).is_none_or(|c| c.is_ascii_whitespace())
+    };
+    let continued = |l: &[u8]| !comment(l) && l[..body(l)].ends_with(b"\\");
+    if !lines.iter().any(|l| material(l) || continued(l)) {
+        return std::borrow::Cow::Borrowed(bytes);
+    }
+    let mut out: Vec<u8> = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < lines.len() {
+        if i > 0 {
+            out.push(b'\n');
+        }
+        let mut taken = 0;
+        if material(lines[i]) {
+            // an empty line
+        } else {
+            while continued(lines[i]) && i + 1 < lines.len() {
+                let l = lines[i];
+                out.extend_from_slice(&l[..body(l) - 1]);
+                out.push(b' ');
+                i += 1;
+                taken += 1;
+            }
+            out.extend_from_slice(lines[i]);
+        }
+        out.extend(std::iter::repeat_n(b'\n', taken));
+        i += 1;
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 fn text_vertex_count(bytes: &[u8]) -> usize {
