@@ -228,6 +228,40 @@ def test_soup_and_open_meshes_fit(tmp_path):
         assert m.is_watertight and len(r.crust_faces) > 0, name
 
 
+def test_glb_normals_flat_by_default_creased_on_request(bunny, tmp_path):
+    """The default GLB carries no normals (viewers shade flat) and every vertex shared:
+    watertight in trimesh as loaded. With ``crease`` the CLI and Python write the same file,
+    valid for the Khronos validator, whose vertices on sharp edges come once per side:
+    trimesh sees seams until it welds, and then the same watertight crust."""
+    import json as _json
+    import struct
+
+    def attrs(path):
+        data = Path(path).read_bytes()
+        (length,) = struct.unpack_from("<I", data, 12)  # the JSON chunk after the 12-byte header
+        return _json.loads(data[20 : 20 + length])["meshes"][0]["primitives"][0]["attributes"]
+
+    r = vf.fit(BUNNY, progress=False, **SMALL)
+    flat = r.save(tmp_path / "flat")["crust"]
+    creased = r.save(tmp_path / "creased", normals="crease")["crust"]
+    run(BUNNY, "-o", tmp_path / "cli.voronoi.glb", "--quiet", "--normals", "crease", *SMALL_CLI)
+    assert (tmp_path / "cli.voronoi.glb").read_bytes() == Path(creased).read_bytes()
+    report = _json.loads((tmp_path / "cli.voronoi.report.json").read_text())
+    assert report["outputs"]["crust_normals"] == "crease:40"
+    for path in (flat, creased):
+        assert_gltf_valid(path)
+    assert "NORMAL" not in attrs(flat) and "NORMAL" in attrs(creased)
+    a = trimesh.load(flat, force="mesh")
+    assert a.is_watertight and len(a.vertices) == len(r.crust_vertices)
+    b = trimesh.load(creased, force="mesh", process=False)
+    assert len(b.vertices) > len(r.crust_vertices)
+    b.merge_vertices(merge_norm=True)
+    assert b.is_watertight and len(b.vertices) == len(r.crust_vertices)
+    assert abs(b.volume - a.volume) < 1e-9 * abs(a.volume)
+    with pytest.raises(vf.InputError, match="crease:DEGREES"):
+        r.save(tmp_path / "bad", normals="round")
+
+
 def test_stub_lists_every_public_name():
     stub = (ROOT / "crates" / "python" / "python" / "voronoi_fit" / "__init__.pyi").read_text()
     for name in vf.__all__:

@@ -210,6 +210,9 @@ pub struct OutputsReport {
     pub sites: String,
     /// The report.
     pub report: String,
+    /// The normals a glTF crust carries (`flat`, `smooth` or `crease:DEG`; empty when the
+    /// writer did not say).
+    pub crust_normals: String,
 }
 
 /// Metrics against the input, or why they could not be computed.

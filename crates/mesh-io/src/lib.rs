@@ -29,7 +29,10 @@ pub use output::{check_output_location, OutputFormat};
 pub use read::{read_mesh, read_mesh_from_bytes, Format};
 pub use topology::TopologyReport;
 pub use weld::{weld_tolerance, WeldStats};
-pub use write::{vertex_normals, write_gltf, write_mesh, write_obj, write_ply, GltfLayout, SceneMesh};
+pub use write::{
+    vertex_normals, write_gltf, write_mesh, write_mesh_with, write_obj, write_ply, GltfLayout, Normals, SceneMesh,
+    DEFAULT_CREASE_DEGREES,
+};
 
 /// An indexed triangle mesh in f64.
 ///

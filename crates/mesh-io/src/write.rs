@@ -22,7 +22,75 @@ pub struct SceneMesh<'a> {
     pub mesh: &'a TriMesh,
     /// Optional per-vertex colours: #V×3 f32 linear RGB in [0, 1] (clamped on write).
     pub colors: Option<&'a [[f32; 3]]>,
+    /// The normals written with it ([`Normals`]).
+    pub normals: Normals,
 }
+
+/// The vertex normals a glTF file carries, which is how viewers shade it.
+///
+/// Measured on crusts (`benches/render.py --smooth`, README "Shading"): with one
+/// area-weighted normal per vertex, every sharp edge of a CAD part shades as a ragged,
+/// blotchy band, because a crust vertex on an edge averages faces of both sides and the
+/// crust's small faces at odd angles there; a vertex can hold only one normal, so no choice
+/// of it fixes that while the vertex is shared.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Normals {
+    /// No NORMAL attribute: glTF viewers must then shade each triangle flat (the glTF 2.0
+    /// specification, *Meshes*). Every vertex stays shared, so the file is as watertight for readers that
+    /// do not weld (trimesh, libigl) as the mesh. The default: what you see is the
+    /// polyhedron, as with OBJ and PLY, which carry no normals either.
+    #[default]
+    Flat,
+    /// One area-weighted normal per vertex, vertices shared: smooth shading, good on smooth
+    /// shapes, blotchy along sharp edges.
+    Smooth,
+    /// Normals smoothed only across edges whose faces meet at less than this many degrees
+    /// (in (0, 180)): the faces around a vertex are grouped by such edges and each group
+    /// gets its own copy of the vertex and its own area-weighted normal. Smooth shapes
+    /// shade smooth and sharp edges stay sharp, but a vertex on a crease is written once per
+    /// side: readers that weld by position (voronoi-fit, Blender) see the same closed
+    /// surface, readers that do not (trimesh without `merge_vertices(merge_norm=True)`) see
+    /// seams.
+    Crease(f64),
+}
+
+impl Normals {
+    /// Parses `flat`, `smooth`, `crease` (40°) or `crease:DEG`.
+    ///
+    /// # Errors
+    /// A message naming the accepted forms.
+    pub fn parse(s: &str) -> Result<Normals, String> {
+        let bad = || format!("normals {s:?}: expected flat, smooth, crease or crease:DEGREES with 0 < DEGREES < 180");
+        match s.trim() {
+            "flat" => Ok(Normals::Flat),
+            "smooth" => Ok(Normals::Smooth),
+            "crease" => Ok(Normals::Crease(DEFAULT_CREASE_DEGREES)),
+            t => {
+                let d: f64 = t.strip_prefix("crease:").ok_or_else(bad)?.trim().parse().map_err(|_| bad())?;
+                if d > 0.0 && d < 180.0 {
+                    Ok(Normals::Crease(d))
+                } else {
+                    Err(bad())
+                }
+            }
+        }
+    }
+}
+
+impl std::fmt::Display for Normals {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Normals::Flat => write!(f, "flat"),
+            Normals::Smooth => write!(f, "smooth"),
+            Normals::Crease(d) => write!(f, "crease:{d}"),
+        }
+    }
+}
+
+/// The crease angle of plain `crease`: above the ~27° at which a crust's faces between
+/// neighbouring pairs lean on smooth shapes (README, *Lined-up pairs*), so those shade
+/// smooth, and well below the 90° of a CAD part's edges.
+pub const DEFAULT_CREASE_DEGREES: f64 = 40.0;
 
 /// The on-disk layout of a glTF scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,7 +108,16 @@ pub enum GltfLayout {
 /// [`crate::ErrorKind::UnknownFormat`] for another extension ([`OutputFormat::from_path`]);
 /// [`crate::ErrorKind::Write`] when the file cannot be written (nothing is left behind).
 pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
-    let scene = || [SceneMesh { name: "mesh", mesh, colors: None }];
+    write_mesh_with(path, mesh, Normals::default())
+}
+
+/// [`write_mesh`] with the normals a glTF file carries (OBJ and PLY are written without
+/// normals whatever `normals` says).
+///
+/// # Errors
+/// As [`write_mesh`].
+pub fn write_mesh_with(path: &Path, mesh: &TriMesh, normals: Normals) -> Result<(), MeshError> {
+    let scene = || [SceneMesh { name: "mesh", mesh, colors: None, normals }];
     match OutputFormat::from_path(path)? {
         OutputFormat::Glb => write_gltf(path, &scene(), GltfLayout::Binary),
         OutputFormat::Gltf => write_gltf(path, &scene(), GltfLayout::Separate),
@@ -53,27 +130,133 @@ pub fn write_mesh(path: &Path, mesh: &TriMesh) -> Result<(), MeshError> {
 /// area gets +Z, so that every normal is a valid unit vector as glTF requires.
 pub fn vertex_normals(mesh: &TriMesh) -> Vec<[f32; 3]> {
     let mut acc = vec![[0.0f64; 3]; mesh.positions.len()];
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-        let n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
-        for &i in t {
+    for &t in &mesh.triangles {
+        let n = face_normal(mesh, t);
+        for &i in &t {
             for k in 0..3 {
                 acc[i as usize][k] += n[k];
             }
         }
     }
-    acc.iter()
+    acc.into_iter().map(unit_f32).collect()
+}
+
+/// A mesh as glTF stores it: vertices split where [`Normals::Crease`] asks (`source[i]` is
+/// the mesh vertex that vertex `i` copies), with its normals (`None` for flat).
+struct Shaded {
+    source: Vec<u32>,
+    normals: Option<Vec<[f32; 3]>>,
+    triangles: Vec<[u32; 3]>,
+}
+
+fn unit_f32(n: [f64; 3]) -> [f32; 3] {
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len > 0.0 && len.is_finite() {
+        [(n[0] / len) as f32, (n[1] / len) as f32, (n[2] / len) as f32]
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+fn face_normal(mesh: &TriMesh, t: [u32; 3]) -> [f64; 3] {
+    let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+    let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+}
+
+fn shade(mesh: &TriMesh, normals: Normals) -> Shaded {
+    let identity = || (0..mesh.positions.len() as u32).collect();
+    match normals {
+        Normals::Flat => Shaded { source: identity(), normals: None, triangles: mesh.triangles.clone() },
+        Normals::Smooth => {
+            Shaded { source: identity(), normals: Some(vertex_normals(mesh)), triangles: mesh.triangles.clone() }
+        }
+        Normals::Crease(degrees) => crease_split(mesh, degrees),
+    }
+}
+
+/// [`Normals::Crease`]: each corner of a face takes the area-weighted normal of the faces
+/// at its vertex within `degrees` of that face (a face of zero area counts as within any
+/// angle), and corners of a vertex with the same normal share one copy of it. The rule is
+/// per face, not grouped across edges: a crust meets a CAD edge in a staircase of small
+/// faces at in-between angles, and grouping faces joined by gentle bends chains across
+/// the edge and smooths it (tried: rendered, the edges and the letters of a 20 mm test cube
+/// came out blotchy). Written here: a few lines over the mesh's own adjacency; no mesh
+/// crate in the tree does it for an indexed mesh.
+fn crease_split(mesh: &TriMesh, degrees: f64) -> Shaded {
+    let nv = mesh.positions.len();
+    let cos = degrees.to_radians().cos();
+    let fnormal: Vec<[f64; 3]> = mesh.triangles.iter().map(|&t| face_normal(mesh, t)).collect();
+    let unit: Vec<Option<[f64; 3]>> = fnormal
+        .iter()
         .map(|n| {
             let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-            if len > 0.0 && len.is_finite() {
-                [(n[0] / len) as f32, (n[1] / len) as f32, (n[2] / len) as f32]
-            } else {
-                [0.0, 0.0, 1.0]
-            }
+            (len > 0.0 && len.is_finite()).then(|| n.map(|x| x / len))
         })
-        .collect()
+        .collect();
+    // Faces around each vertex (CSR, in face order, so that a vertex whose faces are all
+    // within the angle gets exactly `vertex_normals`' sum).
+    let mut start = vec![0usize; nv + 1];
+    for t in &mesh.triangles {
+        for &v in t {
+            start[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..nv {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; start[nv]];
+    for (f, t) in mesh.triangles.iter().enumerate() {
+        for &v in t {
+            around[fill[v as usize]] = f as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let mut source = Vec::with_capacity(nv);
+    let mut out_normals: Vec<[f32; 3]> = Vec::with_capacity(nv);
+    let mut corner = vec![[0u32; 3]; mesh.triangles.len()];
+    let mut copies: Vec<([f32; 3], u32)> = Vec::new();
+    for v in 0..nv {
+        let fs = &around[start[v]..start[v + 1]];
+        copies.clear();
+        for &f in fs {
+            let n = fs
+                .iter()
+                .filter(|&&g| match (unit[f as usize], unit[g as usize]) {
+                    (Some(a), Some(b)) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2] >= cos,
+                    _ => true,
+                })
+                .fold([0.0; 3], |s, &g| {
+                    let n = fnormal[g as usize];
+                    [s[0] + n[0], s[1] + n[1], s[2] + n[2]]
+                });
+            let n = unit_f32(n);
+            let index = match copies.iter().find(|c| c.0 == n) {
+                Some(c) => c.1,
+                None => {
+                    let i = source.len() as u32;
+                    source.push(v as u32);
+                    out_normals.push(n);
+                    copies.push((n, i));
+                    i
+                }
+            };
+            let t = mesh.triangles[f as usize];
+            for k in 0..3 {
+                if t[k] as usize == v {
+                    corner[f as usize][k] = index;
+                }
+            }
+        }
+        if fs.is_empty() {
+            // An unreferenced vertex keeps a place (the mesh had it; glTF allows it).
+            source.push(v as u32);
+            out_normals.push([0.0, 0.0, 1.0]);
+        }
+    }
+    Shaded { source, normals: Some(out_normals), triangles: corner }
 }
 
 fn push_bytes(bin: &mut Vec<u8>, data: impl Iterator<Item = [u8; 4]>) -> (usize, usize) {
@@ -153,7 +336,9 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
     for m in meshes {
         let mut node = json::Node { name: Some(m.name.to_string()), ..Default::default() };
         if let (Some(buffer), false) = (buffer, m.mesh.triangles.is_empty()) {
-            let pos: Vec<[f32; 3]> = m.mesh.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+            let shaded = shade(m.mesh, m.normals);
+            let pos: Vec<[f32; 3]> =
+                shaded.source.iter().map(|&i| m.mesh.positions[i as usize].map(|c| c as f32)).collect();
             let mut lo = [f32::INFINITY; 3];
             let mut hi = [f32::NEG_INFINITY; 3];
             for p in &pos {
@@ -165,22 +350,25 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
             let span = push_bytes(&mut bin, pos.iter().flat_map(|p| p.map(f32::to_le_bytes)));
             let v = view(&mut root, buffer, span, Target::ArrayBuffer);
             let positions = accessor(&mut root, v, pos.len(), C::F32, T::Vec3, Some((lo, hi)));
-            let normals = vertex_normals(m.mesh);
-            let span = push_bytes(&mut bin, normals.iter().flat_map(|p| p.map(f32::to_le_bytes)));
-            let v = view(&mut root, buffer, span, Target::ArrayBuffer);
-            let normals = accessor(&mut root, v, pos.len(), C::F32, T::Vec3, None);
             let mut attributes = BTreeMap::new();
             attributes.insert(Valid(json::mesh::Semantic::Positions), positions);
-            attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
+            if let Some(normals) = &shaded.normals {
+                let span = push_bytes(&mut bin, normals.iter().flat_map(|p| p.map(f32::to_le_bytes)));
+                let v = view(&mut root, buffer, span, Target::ArrayBuffer);
+                let normals = accessor(&mut root, v, pos.len(), C::F32, T::Vec3, None);
+                attributes.insert(Valid(json::mesh::Semantic::Normals), normals);
+            }
             if let Some(colors) = m.colors {
+                let colors: Vec<[f32; 3]> =
+                    shaded.source.iter().map(|&i| colors.get(i as usize).copied().unwrap_or([1.0; 3])).collect();
                 let span = push_bytes(&mut bin, colors.iter().flat_map(|c| c.map(|x| x.clamp(0.0, 1.0).to_le_bytes())));
                 let v = view(&mut root, buffer, span, Target::ArrayBuffer);
                 let colors = accessor(&mut root, v, colors.len(), C::F32, T::Vec3, None);
                 attributes.insert(Valid(json::mesh::Semantic::Colors(0)), colors);
             }
-            let span = push_bytes(&mut bin, m.mesh.triangles.iter().flatten().map(|i| i.to_le_bytes()));
+            let span = push_bytes(&mut bin, shaded.triangles.iter().flatten().map(|i| i.to_le_bytes()));
             let v = view(&mut root, buffer, span, Target::ElementArrayBuffer);
-            let indices = accessor(&mut root, v, 3 * m.mesh.triangles.len(), C::U32, T::Scalar, None);
+            let indices = accessor(&mut root, v, 3 * shaded.triangles.len(), C::U32, T::Scalar, None);
             let mesh = root.push(json::Mesh {
                 extensions: Default::default(),
                 extras: Default::default(),
@@ -210,7 +398,8 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
 }
 
 /// Write a scene of meshes as glTF 2.0, one node per mesh, positions as f32 with exact
-/// min/max, area-weighted normals, optional vertex colours and u32 indices. Meshes with no
+/// min/max, the normals each mesh asks for ([`Normals`]), optional vertex colours and u32
+/// indices. Meshes with no
 /// triangle become empty nodes (an empty crust is a valid result, not an error).
 ///
 /// # Errors

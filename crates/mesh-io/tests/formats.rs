@@ -221,9 +221,9 @@ fn gltf_scene_with_several_nodes_and_colours_reads_back() {
     write_gltf(
         &p,
         &[
-            SceneMesh { name: "a", mesh: &a, colors: None },
-            SceneMesh { name: "empty", mesh: &TriMesh::default(), colors: None },
-            SceneMesh { name: "b", mesh: &b, colors: Some(&colors) },
+            SceneMesh { name: "a", mesh: &a, colors: None, normals: Default::default() },
+            SceneMesh { name: "empty", mesh: &TriMesh::default(), colors: None, normals: Default::default() },
+            SceneMesh { name: "b", mesh: &b, colors: Some(&colors), normals: Default::default() },
         ],
         GltfLayout::Binary,
     )
@@ -234,6 +234,88 @@ fn gltf_scene_with_several_nodes_and_colours_reads_back() {
     let r = TopologyReport::of(&back);
     assert_eq!(r.num_components, 2);
     assert!(r.is_closed);
+}
+
+/// POSITION, NORMAL (if any) and indices of a GLB's first primitive.
+type GlbArrays = (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>, Vec<u32>);
+
+/// The first primitive's POSITION and NORMAL (if any) of a GLB, and its indices.
+fn glb_arrays(path: &Path) -> GlbArrays {
+    let g = gltf::Gltf::open(path).unwrap();
+    let blob = g.blob.as_deref().unwrap();
+    let read = |a: gltf::Accessor| -> Vec<u8> {
+        let v = a.view().unwrap();
+        let at = v.offset() + a.offset();
+        let size = a.size() * a.count();
+        blob[at..at + size].to_vec()
+    };
+    let f32s = |b: Vec<u8>| -> Vec<[f32; 3]> {
+        b.chunks_exact(12)
+            .map(|c| [0, 1, 2].map(|k| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap())))
+            .collect()
+    };
+    let prim = g.meshes().next().unwrap().primitives().next().unwrap();
+    let pos = f32s(read(prim.get(&gltf::Semantic::Positions).unwrap()));
+    let nor = prim.get(&gltf::Semantic::Normals).map(|a| f32s(read(a)));
+    let idx =
+        read(prim.indices().unwrap()).chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect();
+    (pos, nor, idx)
+}
+
+/// The normals a GLB carries: none by default (viewers shade flat; every vertex shared),
+/// one per vertex with `Smooth`, and with `Crease` a copy of a vertex per side of each
+/// sharp edge (a cube's corner three times, each with its face's normal) but none on a
+/// smooth shape, whose normals are then the smooth ones. Every file reads back as the same
+/// closed mesh (the reader welds by position) and goes to the Khronos validator.
+#[test]
+fn glb_normals_flat_smooth_and_creased() {
+    use mesh_io::{write_mesh_with, Normals};
+    let d = tmp();
+    let cube = shapes::cuboid([0.0; 3], [1.0, 2.0, 3.0]);
+    let sphere = shapes::icosphere(3);
+    for (name, mesh) in [("cube", &cube), ("sphere", &sphere)] {
+        for normals in [Normals::Flat, Normals::Smooth, Normals::Crease(40.0)] {
+            let p = d.path().join(format!("{name}_{}.glb", normals.to_string().replace(':', "_")));
+            write_mesh_with(&p, mesh, normals).unwrap();
+            keep_for_validation(&p, "normals");
+            let back = read_mesh(&p).unwrap();
+            assert!(back.canonical_triangles() == f32_rounded(mesh).canonical_triangles(), "{name} {normals}");
+            let (pos, nor, idx) = glb_arrays(&p);
+            assert_eq!(idx.len(), 3 * mesh.triangles.len());
+            match (normals, name) {
+                (Normals::Flat, _) => assert!(nor.is_none() && pos.len() == mesh.positions.len()),
+                (Normals::Smooth, _) => assert_eq!(nor.unwrap(), mesh_io::vertex_normals(mesh)),
+                (Normals::Crease(_), "cube") => {
+                    assert_eq!(pos.len(), 24, "each of 8 corners once per face");
+                    let nor = nor.unwrap();
+                    for t in idx.chunks_exact(3) {
+                        let [a, b, c] = [0, 1, 2].map(|k| pos[t[k] as usize].map(f64::from));
+                        let e = [[b[0] - a[0], b[1] - a[1], b[2] - a[2]], [c[0] - a[0], c[1] - a[1], c[2] - a[2]]];
+                        let n = [
+                            e[0][1] * e[1][2] - e[0][2] * e[1][1],
+                            e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                            e[0][0] * e[1][1] - e[0][1] * e[1][0],
+                        ];
+                        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                        for &i in t {
+                            let dot: f64 = (0..3).map(|k| f64::from(nor[i as usize][k]) * n[k] / len).sum();
+                            assert!(dot > 1.0 - 1e-6, "a cube's corner takes its face's normal ({dot})");
+                        }
+                    }
+                }
+                (Normals::Crease(_), _) => {
+                    assert_eq!(pos.len(), mesh.positions.len(), "no crease on an icosphere");
+                    assert_eq!(nor.unwrap(), mesh_io::vertex_normals(mesh));
+                }
+            }
+        }
+    }
+    assert_eq!(Normals::parse("crease").unwrap(), Normals::Crease(mesh_io::DEFAULT_CREASE_DEGREES));
+    assert_eq!(Normals::parse("crease:30").unwrap(), Normals::Crease(30.0));
+    assert_eq!(Normals::parse("flat").unwrap(), Normals::default());
+    for bad in ["crease:0", "crease:180", "crease:x", "round", ""] {
+        assert!(Normals::parse(bad).is_err(), "{bad}");
+    }
 }
 
 /// A glTF written by hand: a node with a mirroring scale (negative determinant) under a

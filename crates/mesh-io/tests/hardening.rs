@@ -141,8 +141,12 @@ fn a_gltf_whose_node_transform_overflows_the_range_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let m = shapes::icosphere(0);
     let p = d.path().join("s.gltf");
-    mesh_io::write_gltf(&p, &[mesh_io::SceneMesh { name: "m", mesh: &m, colors: None }], mesh_io::GltfLayout::Separate)
-        .unwrap();
+    mesh_io::write_gltf(
+        &p,
+        &[mesh_io::SceneMesh { name: "m", mesh: &m, colors: None, normals: Default::default() }],
+        mesh_io::GltfLayout::Separate,
+    )
+    .unwrap();
     let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
     json["nodes"][0]["scale"] = serde_json::json!([1e35, 1.0, 1.0]);
     std::fs::write(&p, serde_json::to_vec(&json).unwrap()).unwrap();

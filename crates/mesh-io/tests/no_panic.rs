@@ -12,7 +12,12 @@ fn seeds() -> Vec<(&'static str, Vec<u8>)> {
     let file = |name: &str| dir.path().join(name);
     write_obj(&file("a.obj"), &m).unwrap();
     write_ply(&file("a.ply"), &m).unwrap();
-    write_gltf(&file("a.glb"), &[SceneMesh { name: "m", mesh: &m, colors: None }], GltfLayout::Binary).unwrap();
+    write_gltf(
+        &file("a.glb"),
+        &[SceneMesh { name: "m", mesh: &m, colors: None, normals: Default::default() }],
+        GltfLayout::Binary,
+    )
+    .unwrap();
     let mut stl = vec![0u8; 80];
     stl.extend_from_slice(&(m.triangles.len() as u32).to_le_bytes());
     let mut ascii_stl = String::from("solid s\n");

@@ -243,10 +243,13 @@ fn crust_of_sites<'py>(py: Python<'py>, sites: &[u8], labels: &[u8], transform: 
 
 /// Writes a mesh atomically (temporary file, then rename) in the format of the path's
 /// extension (.glb, .gltf, .obj, .ply), as the CLI writes its outputs.
+/// `normals`: `flat`, `smooth` or `crease[:DEG]` ([`mesh_io::Normals`]; glTF only).
 #[pyfunction]
-fn save_mesh(py: Python<'_>, path: &str, vertices: &[u8], faces: &[u8]) -> PyResult<()> {
+#[pyo3(signature = (path, vertices, faces, normals = "flat"))]
+fn save_mesh(py: Python<'_>, path: &str, vertices: &[u8], faces: &[u8], normals: &str) -> PyResult<()> {
     let m = mesh(vertices, faces, path)?;
-    py.allow_threads(|| mesh_io::write_mesh(std::path::Path::new(path), &m)).map_err(|e| {
+    let normals = mesh_io::Normals::parse(normals).map_err(input_error)?;
+    py.allow_threads(|| mesh_io::write_mesh_with(std::path::Path::new(path), &m, normals)).map_err(|e| {
         if e.kind == mesh_io::ErrorKind::Write {
             failure(e)
         } else {

@@ -85,8 +85,7 @@ fn prepare_text(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
     let comment = |l: &[u8]| l.trim_ascii_start().starts_with(b"#");
     let material = |l: &[u8]| {
         let t = l.trim_ascii_start();
-        (t.starts_with(b"usemtl") || t.starts_with(b"mtllib"))
-            && t.get(6).is_none_or(|c| c.is_ascii_whitespace())
+        (t.starts_with(b"usemtl") || t.starts_with(b"mtllib")) && t.get(6).is_none_or(|c| c.is_ascii_whitespace())
     };
     let continued = |l: &[u8]| !comment(l) && l[..body(l)].ends_with(b"\\");
     if !lines.iter().any(|l| material(l) || continued(l)) {

@@ -125,13 +125,20 @@ def load_mesh(path: "str | os.PathLike[str]") -> tuple[np.ndarray, np.ndarray]:
     return _from(v, "<f8", 3), _from(f, "<u4", 3)
 
 
-def save_mesh(path: "str | os.PathLike[str]", vertices: Any, faces: Any) -> None:
+def save_mesh(path: "str | os.PathLike[str]", vertices: Any, faces: Any, normals: str = "flat") -> None:
     """Write a mesh atomically (temporary file beside it, then rename) as the CLI writes
     its outputs: .glb, .gltf (+ .bin), .obj or binary .ply by the extension. glTF holds
     float32, so positions are rounded there (for a crust, fit with ``float32=True``
-    first: see :meth:`FitResult.save`)."""
+    first: see :meth:`FitResult.save`).
+
+    ``normals`` (glTF only, as the CLI's ``--normals``): ``"flat"`` writes none, so viewers
+    shade each triangle flat and every vertex stays shared (watertight in trimesh);
+    ``"smooth"`` one area-weighted normal per vertex; ``"crease"`` or ``"crease:DEG"``
+    smooth except across edges sharper than DEG (40 by default), a vertex on such an edge
+    written once per side (``trimesh.load`` then shows seams until
+    ``merge_vertices(merge_norm=True)``)."""
     v, f = _rows(vertices, "vertices"), _faces(faces, "faces")
-    _native.save_mesh(os.fspath(path), v.tobytes(), f.tobytes())
+    _native.save_mesh(os.fspath(path), v.tobytes(), f.tobytes(), normals)
 
 
 def _atomic_text(path: str, text: str) -> None:
@@ -173,12 +180,13 @@ class FitResult:
 
         return trimesh.Trimesh(self.crust_vertices, self.crust_faces, process=False)
 
-    def save(self, prefix: "str | os.PathLike[str]", format: str = "glb") -> dict:
+    def save(self, prefix: "str | os.PathLike[str]", format: str = "glb", normals: str = "flat") -> dict:
         """Write ``PREFIX.voronoi.FORMAT`` (the crust), ``PREFIX.voronoi.sites.npz`` and
         ``PREFIX.voronoi.report.json``, each atomically, as ``voronoi-fit MESH -o
         PREFIX.voronoi.FORMAT`` names them; returns the paths. A .glb/.gltf crust must
         come from ``fit(..., float32=True)``, which rounds and checks it as glTF stores it
-        (a float64 crust is refused there with that advice); .obj and .ply keep float64."""
+        (a float64 crust is refused there with that advice); .obj and .ply keep float64.
+        ``normals``: as for :func:`save_mesh`."""
         if format in ("glb", "gltf") and not np.array_equal(
             self.crust_vertices.astype(np.float32).astype(np.float64), self.crust_vertices
         ):
@@ -194,7 +202,7 @@ class FitResult:
             np.ascontiguousarray(self.labels, dtype=np.uint8).tobytes(),
             np.ascontiguousarray(self.transform, dtype="<f8").tobytes(),
         )
-        save_mesh(paths["crust"], self.crust_vertices, self.crust_faces)
+        save_mesh(paths["crust"], self.crust_vertices, self.crust_faces, normals)
         _atomic_text(paths["report"], json.dumps(self.report, indent=2))
         return paths
 
