@@ -329,8 +329,19 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.json {
         crate::output::out!("{}", done.json);
     } else {
+        // How viewers will shade a glTF crust (README, *Looking at the result*).
+        let gltf = matches!(
+            mesh_io::OutputFormat::from_path(&done.out.mesh),
+            Ok(mesh_io::OutputFormat::Glb | mesh_io::OutputFormat::Gltf)
+        );
+        let shading = match args.normals {
+            _ if !gltf => String::new(),
+            mesh_io::Normals::Flat => " (flat-shaded; --normals crease shades smooth surfaces smooth)".into(),
+            mesh_io::Normals::Smooth => " (smooth normals)".into(),
+            mesh_io::Normals::Crease(d) => format!(" (normals creased at {d}°)"),
+        };
         crate::output::out!(
-            "{} Wrote {}, {}, {} and {} in {:.1} s.",
+            "{} Wrote {}{shading}, {}, {} and {} in {:.1} s.",
             done.report.summary(),
             done.out.mesh.display(),
             done.out.sites.display(),
