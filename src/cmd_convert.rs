@@ -14,14 +14,8 @@ pub struct Args {
     /// Output file: .glb, .gltf (+ .bin beside it), .obj or binary .ply.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Normals in a glTF output: `flat` (none: viewers shade each triangle flat; every
-    /// vertex shared, so watertight in any reader), `smooth` (one area-weighted normal per
-    /// vertex: smooth shapes shade smooth, sharp edges blotchy) or `crease[:DEG]` (smooth
-    /// except across edges sharper than DEG, 40 by default; a vertex on such an edge is
-    /// written once per side, which readers that do not weld see as seams). OBJ and PLY
-    /// carry no normals.
-    #[arg(long, default_value = "flat", value_parser = mesh_io::Normals::parse, value_name = "flat|smooth|crease[:DEG]")]
-    pub normals: mesh_io::Normals,
+    #[command(flatten)]
+    pub normals: crate::output::NormalsArg,
     /// Map the mesh into the unit cube (uniform scale, centred) before writing.
     #[arg(long)]
     pub normalize: bool,
@@ -66,6 +60,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else if format.stores_f32() {
         mesh_io::check_f32_resolution(&mesh, &args.mesh)?;
     }
-    mesh_io::write_mesh_with(&args.output, &mesh, args.normals)?;
+    mesh_io::write_mesh_with(&args.output, &mesh, args.normals.normals)?;
     Ok(())
 }

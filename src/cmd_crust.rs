@@ -20,14 +20,8 @@ pub struct Args {
     /// Output crust: .glb, .gltf, .obj or .ply (by extension).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Normals in a glTF crust: `flat` (none: viewers shade each triangle flat; every
-    /// vertex shared, so watertight in any reader), `smooth` (one area-weighted normal per
-    /// vertex: smooth shapes shade smooth, sharp edges blotchy) or `crease[:DEG]` (smooth
-    /// except across edges sharper than DEG, 40 by default; a vertex on such an edge is
-    /// written once per side, which readers that do not weld see as seams). OBJ and PLY
-    /// carry no normals.
-    #[arg(long, default_value = "flat", value_parser = mesh_io::Normals::parse, value_name = "flat|smooth|crease[:DEG]")]
-    pub normals: mesh_io::Normals,
+    #[command(flatten)]
+    pub normals: crate::output::NormalsArg,
     /// Also write every inside cell as a closed convex polyhedron, one node per cell (.glb
     /// or .gltf).
     #[arg(long)]
@@ -51,7 +45,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let precision = Precision::of_path(&args.output)?;
     let written = finalize(&crust, file.transform, precision).in_file(&args.sites)?;
     let (out, check) = (&written.mesh, &written.check);
-    mesh_io::write_mesh_with(&args.output, out, args.normals)?;
+    mesh_io::write_mesh_with(&args.output, out, args.normals.normals)?;
     let mut num_cells = 0;
     if let Some(path) = &args.cells {
         let cells = crust.cells().in_file(&args.sites)?;
