@@ -28,7 +28,7 @@ pub struct SceneMesh<'a> {
 
 /// The vertex normals a glTF file carries, which is how viewers shade it.
 ///
-/// Measured on crusts (`benches/render.py --smooth`, README "Shading"): with one
+/// Measured on crusts (`benches/render.py --smooth`, README *Looking at the result*): with one
 /// area-weighted normal per vertex, every sharp edge of a CAD part shades as a ragged,
 /// blotchy band, because a crust vertex on an edge averages faces of both sides and the
 /// crust's small faces at odd angles there; a vertex can hold only one normal, so no choice
@@ -36,19 +36,19 @@ pub struct SceneMesh<'a> {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum Normals {
     /// No NORMAL attribute: glTF viewers must then shade each triangle flat (the glTF 2.0
-    /// specification, *Meshes*). Every vertex stays shared, so the file is as watertight for readers that
-    /// do not weld (trimesh, libigl) as the mesh. The default: what you see is the
-    /// polyhedron, as with OBJ and PLY, which carry no normals either.
+    /// specification, *Meshes*). Every vertex stays shared, so the file is as watertight for
+    /// readers that do not weld (trimesh, libigl) as the mesh. The default: what you see is
+    /// the polyhedron, as with OBJ and PLY, which carry no normals either.
     #[default]
     Flat,
     /// One area-weighted normal per vertex, vertices shared: smooth shading, good on smooth
     /// shapes, blotchy along sharp edges.
     Smooth,
-    /// Normals smoothed only across edges whose faces meet at less than this many degrees
-    /// (in (0, 180)): the faces around a vertex are grouped by such edges and each group
-    /// gets its own copy of the vertex and its own area-weighted normal. Smooth shapes
-    /// shade smooth and sharp edges stay sharp, but a vertex on a crease is written once per
-    /// side: readers that weld by position (voronoi-fit, Blender) see the same closed
+    /// Normals smoothed only between faces less than this many degrees apart (in (0, 180)):
+    /// each face corner takes the area-weighted normal of the faces at its vertex within the
+    /// angle of that face, and the corners of a vertex with the same normal share one copy
+    /// of it (`crease_split`). Smooth shapes shade smooth and sharp edges stay sharp, but a
+    /// vertex on a crease is written once per side: readers that weld by position (voronoi-fit, Blender) see the same closed
     /// surface, readers that do not (trimesh without `merge_vertices(merge_norm=True)`) see
     /// seams.
     Crease(f64),
@@ -399,8 +399,8 @@ fn build_scene(meshes: &[SceneMesh], bin_uri: Option<String>) -> (json::Root, Ve
 
 /// Write a scene of meshes as glTF 2.0, one node per mesh, positions as f32 with exact
 /// min/max, the normals each mesh asks for ([`Normals`]), optional vertex colours and u32
-/// indices. Meshes with no
-/// triangle become empty nodes (an empty crust is a valid result, not an error).
+/// indices. Meshes with no triangle become empty nodes (an empty crust is a valid result,
+/// not an error).
 ///
 /// # Errors
 /// [`crate::ErrorKind::Write`] when a file cannot be written; nothing partial is left.

@@ -80,7 +80,6 @@ pub(crate) fn read(bytes: &[u8], path: &Path) -> Result<TriMesh> {
 ///
 /// Borrowed when there is nothing to change.
 fn prepare_text(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
-    let lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
     let body = |l: &[u8]| -> usize { l.len() - usize::from(l.ends_with(b"\r")) };
     let comment = |l: &[u8]| l.trim_ascii_start().starts_with(b"#");
     let material = |l: &[u8]| {
@@ -88,9 +87,10 @@ fn prepare_text(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
         (t.starts_with(b"usemtl") || t.starts_with(b"mtllib")) && t.get(6).is_none_or(|c| c.is_ascii_whitespace())
     };
     let continued = |l: &[u8]| !comment(l) && l[..body(l)].ends_with(b"\\");
-    if !lines.iter().any(|l| material(l) || continued(l)) {
+    if !bytes.split(|&b| b == b'\n').any(|l| material(l) || continued(l)) {
         return std::borrow::Cow::Borrowed(bytes);
     }
+    let lines: Vec<&[u8]> = bytes.split(|&b| b == b'\n').collect();
     let mut out: Vec<u8> = Vec::with_capacity(bytes.len());
     let mut i = 0;
     while i < lines.len() {
