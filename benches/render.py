@@ -20,7 +20,8 @@ its area: the painter's algorithm drawn before (a PolyCollection with edges in t
 colour) gave every sliver and step face of a crust a line at least a pixel wide, and
 smooth crusts looked speckled. Faces seen from behind (back faces: open
 meshes, inward-facing bodies, wrong orientation) are drawn in orange, so orientation
-problems are visible. Meshes of ~200k triangles take a few seconds per panel. Meshes are
+problems are visible. `--smooth file` instead shades a GLB by the NORMAL attribute it
+carries, as a glTF viewer does (`voronoi-fit --normals`). Meshes of ~200k triangles take a few seconds per panel. Meshes are
 read with trimesh (GLB scenes flattened with their node transforms).
 """
 import argparse
@@ -65,33 +66,6 @@ def frame_of(V):
 SS = 3  # samples per pixel along each axis
 
 
-def vertex_normals(P, F, crease=None):
-    """Per-corner normals (len(F), 3, 3): area-weighted over each vertex's faces, as the GLB
-    writer's NORMAL attribute (crease=None), or only over the faces within `crease` degrees
-    of the corner's own face (the normals a writer that splits vertices at creases gives)."""
-    n = np.cross(P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]])  # area-weighted
-    if crease is None:
-        acc = np.zeros_like(P)
-        for k in range(3):
-            np.add.at(acc, F[:, k], n)
-        out = acc[F]
-    else:
-        u = n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-        c = np.cos(np.radians(crease))
-        out = np.zeros((len(F), 3, 3))
-        faces_of = [[] for _ in range(len(P))]
-        for f, t in enumerate(F):
-            for v in t:
-                faces_of[v].append(f)
-        for f, t in enumerate(F):
-            for k, v in enumerate(t):
-                g = np.array(faces_of[v])
-                keep = g[u[g] @ u[f] >= c]
-                out[f, k] = n[keep].sum(0)
-    ln = np.linalg.norm(out, axis=2, keepdims=True)
-    return out / np.where(ln > 0, ln, 1)
-
-
 def glb_with_normals(path):
     """(V, F, per-corner normals) of a GLB as a viewer shades it: the file's own vertices
     (not welded) and its NORMAL attribute, or None when the file has no normals (flat).
@@ -129,8 +103,8 @@ def glb_with_normals(path):
 
 def draw(ax, V, F, R, center, scale, pixels=380, smooth=None):
     """One panel: orthographic, two-sided Lambert, depth buffer, SSxSS samples a pixel.
-    Flat-shaded, or with `smooth` ("area" or a crease angle in degrees) each pixel shaded
-    by the corner normals interpolated, as a glTF viewer shades a mesh with normals."""
+    Flat-shaded, or with `smooth` (per-corner normals, (len(F), 3, 3)) each pixel shaded by
+    the corner normals interpolated, as a glTF viewer shades a mesh with normals."""
     ax.set_xlim(-1.02, 1.02)
     ax.set_ylim(-1.02, 1.02)
     ax.set_aspect("equal")
@@ -150,10 +124,8 @@ def draw(ax, V, F, R, center, scale, pixels=380, smooth=None):
         colors = np.clip(np.where(back[:, None], BACK_COLOR, FRONT_COLOR) * shade, 0, 1)
         depth = np.full((n_px, n_px), -np.inf)
         corner = None
-        if isinstance(smooth, np.ndarray):
+        if smooth is not None:
             corner = smooth @ R.T
-        elif smooth is not None:
-            corner = vertex_normals(P, F, None if smooth == "area" else float(smooth))
         for fi, (f, col) in enumerate(zip(F, colors)):
             (ax_, ay), (bx, by), (cx, cy) = XY[f]
             x0, x1 = int(max(0, np.floor(min(ax_, bx, cx)))), int(min(n_px - 1, np.ceil(max(ax_, bx, cx))))
@@ -241,10 +213,9 @@ def main():
     ap.add_argument("--views", help="comma-separated of " + ", ".join(VIEWS))
     ap.add_argument("--title")
     ap.add_argument("--grid", action="store_true", help="(input, crust) pairs, one row each")
-    ap.add_argument("--smooth", help="shade with interpolated vertex normals: 'area' (area-weighted over every "
-                    "face, as `--normals smooth` writes), a crease angle in degrees (approximately `--normals crease:DEG`), or "
-                    "'file' (a GLB's own NORMAL attribute, flat when it has none: what a glTF viewer shows); comma-separated per column "
-                    "('flat' for flat shading); default flat")
+    ap.add_argument("--smooth", help="per column, comma-separated: 'file' shades a GLB with its own NORMAL "
+                    "attribute interpolated (flat when it has none), as a glTF viewer does; 'flat' (the default) "
+                    "shades every triangle flat")
     a = ap.parse_args()
     if a.grid:
         if len(a.meshes) % 2:
@@ -261,6 +232,8 @@ def main():
         smooth = None
         if a.smooth:
             smooth = [None if x == "flat" else x for x in a.smooth.split(",")]
+            if any(x not in (None, "file") for x in smooth):
+                ap.error("--smooth takes flat or file per column")
             smooth = smooth * len(a.meshes) if len(smooth) == 1 else smooth
         render_columns(a.meshes, labels, a.output, up=a.up,
                        views=tuple(a.views.split(",")) if a.views else ("front", "side", "top"), title=a.title,
