@@ -14,8 +14,9 @@ pub struct Args {
     /// Output file: .glb, .gltf (+ .bin beside it), .obj or binary .ply.
     #[arg(short, long)]
     pub output: PathBuf,
-    #[command(flatten)]
-    pub normals: crate::output::NormalsArg,
+    #[arg(long, default_value = "flat", value_parser = mesh_io::Normals::parse, value_name = "flat|smooth|crease[:DEG]",
+          help = crate::output::NORMALS_HELP)]
+    pub normals: mesh_io::Normals,
     /// Map the mesh into the unit cube (uniform scale, centred) before writing.
     #[arg(long)]
     pub normalize: bool,
@@ -60,6 +61,6 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else if format.stores_f32() {
         mesh_io::check_f32_resolution(&mesh, &args.mesh)?;
     }
-    mesh_io::write_mesh_with(&args.output, &mesh, args.normals.normals)?;
+    mesh_io::write_mesh_with(&args.output, &mesh, args.normals)?;
     Ok(())
 }

@@ -20,8 +20,9 @@ pub struct Args {
     /// Output crust: .glb, .gltf, .obj or .ply (by extension).
     #[arg(short, long)]
     pub output: PathBuf,
-    #[command(flatten)]
-    pub normals: crate::output::NormalsArg,
+    #[arg(long, default_value = "flat", value_parser = mesh_io::Normals::parse, value_name = "flat|smooth|crease[:DEG]",
+          help = crate::output::NORMALS_HELP)]
+    pub normals: mesh_io::Normals,
     /// Also write every inside cell as a closed convex polyhedron, one node per cell (.glb
     /// or .gltf).
     #[arg(long)]
@@ -45,7 +46,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     let precision = Precision::of_path(&args.output)?;
     let written = finalize(&crust, file.transform, precision).in_file(&args.sites)?;
     let (out, check) = (&written.mesh, &written.check);
-    mesh_io::write_mesh_with(&args.output, out, args.normals.normals)?;
+    mesh_io::write_mesh_with(&args.output, out, args.normals)?;
     let mut num_cells = 0;
     if let Some(path) = &args.cells {
         let cells = crust.cells().in_file(&args.sites)?;

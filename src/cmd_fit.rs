@@ -25,8 +25,9 @@ pub struct Args {
     /// the current directory. The sites file, report and checkpoint go beside it.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    #[command(flatten)]
-    pub normals: crate::output::NormalsArg,
+    #[arg(long, default_value = "flat", value_parser = mesh_io::Normals::parse, value_name = "flat|smooth|crease[:DEG]",
+          help = crate::output::NORMALS_HELP)]
+    pub normals: mesh_io::Normals,
     /// Number of trainable sites K (plus ⌈√K⌉ fixed outside sites on the cube's faces).
     #[arg(long)]
     pub sites: Option<usize>,
@@ -328,7 +329,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
             mesh_io::OutputFormat::from_path(&done.out.mesh),
             Ok(mesh_io::OutputFormat::Glb | mesh_io::OutputFormat::Gltf)
         );
-        let shading = match args.normals.normals {
+        let shading = match args.normals {
             _ if !gltf => String::new(),
             mesh_io::Normals::Flat => " (flat-shaded; --normals crease shades smooth surfaces smooth)".into(),
             mesh_io::Normals::Smooth => " (smooth normals)".into(),
@@ -409,7 +410,7 @@ pub fn fit_to_files(
 /// run finished), and the optional page.
 fn write_outputs(out: Outputs, result: fit::FitOutput, args: &Args, t_all: Instant) -> Result<Written, CliError> {
     result.sites.write(&out.sites)?;
-    mesh_io::write_mesh_with(&out.mesh, &result.crust, args.normals.normals)?;
+    mesh_io::write_mesh_with(&out.mesh, &result.crust, args.normals)?;
     // OUT.png: input and crust side by side from three views (the input is read again, as
     // only the result reaches this function; reading is cheap next to the fit).
     let picture = crate::cmd_view::picture_path(&out.mesh);
@@ -419,7 +420,7 @@ fn write_outputs(out: Outputs, result: fit::FitOutput, args: &Args, t_all: Insta
         crust: out.mesh.display().to_string(),
         sites: out.sites.display().to_string(),
         report: out.report.display().to_string(),
-        crust_normals: args.normals.normals.to_string(),
+        crust_normals: args.normals.to_string(),
     };
     report.total_seconds = t_all.elapsed().as_secs_f64();
     let json = serde_json::to_string_pretty(&report).map_err(anyhow::Error::from)?;

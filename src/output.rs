@@ -22,15 +22,13 @@ macro_rules! out {
 }
 pub(crate) use out;
 
-/// `--normals`, shared by `fit`, `crust` and `convert` (README, *Looking at the result*).
-#[derive(clap::Args, Clone, Copy, Debug)]
-pub struct NormalsArg {
-    /// Normals in a glTF output: `flat` (none: viewers shade each triangle flat; every
-    /// vertex shared, so watertight in any reader), `smooth` (one area-weighted normal per
-    /// vertex: smooth shapes shade smooth, sharp edges blotchy) or `crease[:DEG]` (smooth
-    /// except across edges sharper than DEG, 40 by default; a vertex on such an edge is
-    /// written once per side, which readers that do not weld see as seams). OBJ and PLY
-    /// carry no normals.
-    #[arg(long, default_value = "flat", value_parser = mesh_io::Normals::parse, value_name = "flat|smooth|crease[:DEG]")]
-    pub normals: mesh_io::Normals,
-}
+/// The help of `--normals`, shared by `fit`, `crust` and `convert` (README, *Looking at the
+/// result*). A constant rather than a flattened argument struct: the main job's arguments
+/// are themselves flattened, optionally, into the top-level parser, and clap does not see
+/// a nested flattened group's arguments there (`voronoi-fit MESH --normals crease` was
+/// then taken for no mesh at all).
+pub const NORMALS_HELP: &str =
+    "Normals in a glTF output: `flat` (none: viewers shade each triangle flat; every vertex \
+    shared, so watertight in any reader), `smooth` (one area-weighted normal per vertex: smooth shapes shade smooth, \
+    sharp edges blotchy) or `crease[:DEG]` (smooth except across edges sharper than DEG, 40 by default; a vertex on \
+    such an edge is written once per side, which readers that do not weld see as seams). OBJ and PLY carry no normals";
