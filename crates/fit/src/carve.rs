@@ -67,6 +67,22 @@ pub struct CarveReport {
     /// distance, then least farthest vertex, then least summed excess of the stray
     /// vertices) came before them.
     pub undone_rounds: usize,
+    /// The uncarved crust's Chamfer L1 distance and normal consistency against the input
+    /// (from the samples of the F-score; unit-cube lengths).
+    pub first_surface: SurfaceBar,
+    /// Whether carving stopped before its first round because the uncarved crust did not
+    /// reach [`CarveOptions::gate`].
+    pub gated: bool,
+}
+
+/// Chamfer L1 distance (unit-cube lengths) and normal consistency of a crust against the
+/// input, from the samples of carving's F-score.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SurfaceBar {
+    /// Chamfer L1.
+    pub chamfer_l1: f64,
+    /// Normal consistency.
+    pub normal_consistency: f64,
 }
 
 /// How [`carve`] runs.
@@ -81,12 +97,17 @@ pub struct CarveOptions {
     pub max_new: usize,
     /// Whether the inserted sites get their mirror images ([`mirror_closure`]).
     pub mirrors: bool,
+    /// Stop before the first round (nothing inserted; [`CarveReport::gated`]) when the
+    /// uncarved crust's Chamfer distance is larger or its normal consistency lower than
+    /// these: the fit's second, aligned polish is measured against the plain one's this way
+    /// before it pays for carving (`run.rs`).
+    pub gate: Option<SurfaceBar>,
 }
 
 impl CarveOptions {
     /// The main job's: [`ROUNDS`] rounds and K/8 sites for `k` sites, with mirrors.
     pub fn for_sites(tolerance: f64, k: usize) -> Self {
-        CarveOptions { tolerance, rounds: ROUNDS, max_new: k / 8, mirrors: true }
+        CarveOptions { tolerance, rounds: ROUNDS, max_new: k / 8, mirrors: true, gate: None }
     }
 }
 
@@ -111,7 +132,7 @@ pub fn carve(
     solid: &dyn Solid,
     options: &CarveOptions,
 ) -> Result<CarveReport, FitError> {
-    let CarveOptions { tolerance, rounds, max_new, mirrors } = *options;
+    let CarveOptions { tolerance, rounds, max_new, mirrors, gate } = *options;
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
     let open_edges = mesh_io::topology::boundary_edges(mesh);
@@ -146,7 +167,20 @@ pub fn carve(
         } else {
             metrics::hausdorff::directed_certify_prepared(&input, &crust_distance, &certify).map_err(failure)?.hi
         };
-        let fscore = metrics::surface_metrics_of(&input, &crust_distance, &surface_options).map_err(failure)?.fscore;
+        let surface = metrics::surface_metrics_of(&input, &crust_distance, &surface_options).map_err(failure)?;
+        let fscore = surface.fscore;
+        if round == 0 {
+            report.first_surface =
+                SurfaceBar { chamfer_l1: surface.chamfer_l1, normal_consistency: surface.normal_consistency };
+            if let Some(bar) = gate {
+                // NaN compares false both ways: a NaN stops too.
+                let reaches =
+                    surface.chamfer_l1 <= bar.chamfer_l1 && surface.normal_consistency >= bar.normal_consistency;
+                if !reaches {
+                    report.gated = true;
+                }
+            }
+        }
         states.push(State { sites: sites.len(), farthest, missed, excess, fscore });
         report.farthest_per_round.push(farthest);
         report.input_farthest_per_round.push(missed);
@@ -187,7 +221,7 @@ pub fn carve(
             triangle: samples.triangles[i],
             at_input: true,
         }));
-        if round == rounds || stray.is_empty() || budget < 2 || stale {
+        if round == rounds || stray.is_empty() || budget < 2 || stale || report.gated {
             break;
         }
         stray.sort_by(|a, b| {

@@ -156,6 +156,12 @@ pub struct FitConfig {
     /// `None`: off (`--no-polish`, and the paper preset). Not used on a thin shell, whose
     /// sites are placed on the shell's two sides, not on the sampled surface.
     pub polish: Option<soft_voronoi::PolishConfig>,
+    /// On a closed input, when `polish` has no alignment term of its own: polish a second
+    /// time with this one and keep that crust only if it is at least as good on all four
+    /// metrics against the input and better on one (the report's `polish_choice`). Default
+    /// [`soft_voronoi::polish::Alignment::default`]; `None`: the plain polish only
+    /// (`--polish-align 0`).
+    pub try_alignment: Option<soft_voronoi::polish::Alignment>,
 }
 
 impl FitConfig {
@@ -185,6 +191,7 @@ impl FitConfig {
             refine: None,
             skip_metrics: false,
             polish: Some(soft_voronoi::PolishConfig::default_for(num_sites, 0)),
+            try_alignment: Some(soft_voronoi::polish::Alignment::default()),
         }
     }
 
@@ -215,6 +222,14 @@ impl FitConfig {
                 self.polish = serde_json::from_value(p.clone()).map_err(|e| {
                     FitError::Input(format!("{}: the checkpoint's polish settings: {e}", path.display()))
                 })?;
+                // The choice of the aligned polish came later: a checkpoint without it was
+                // written by a run that polished once.
+                self.try_alignment = match map.get("try_alignment") {
+                    Some(a) => serde_json::from_value(a.clone()).map_err(|e| {
+                        FitError::Input(format!("{}: the checkpoint's alignment settings: {e}", path.display()))
+                    })?,
+                    None => None,
+                };
             }
         }
         self.train = state.config.clone();
@@ -224,7 +239,8 @@ impl FitConfig {
     }
 
     /// What a checkpoint stores beside the training state: the sampling settings and the
-    /// polish settings, as one JSON object (the sampling's fields plus `polish`), so a
+    /// polish settings, as one JSON object (the sampling's fields plus `polish` and
+    /// `try_alignment`), so a
     /// resume continues exactly the run that was stopped.
     ///
     /// # Errors
@@ -234,6 +250,7 @@ impl FitConfig {
         let mut v = serde_json::to_value(&self.sampling).map_err(fail)?;
         if let serde_json::Value::Object(map) = &mut v {
             map.insert("polish".into(), serde_json::to_value(&self.polish).map_err(fail)?);
+            map.insert("try_alignment".into(), serde_json::to_value(&self.try_alignment).map_err(fail)?);
         }
         serde_json::to_string(&v).map_err(fail)
     }

@@ -67,8 +67,11 @@ pub struct FitOptions {
     pub polish_steps: Option<usize>,
     /// Polish learning rate (default 1e-3 at K = 8,192, scaled by √(8192/K)).
     pub polish_lr: Option<f64>,
-    /// Weight of the polish's alignment term (`soft_voronoi::polish::Alignment`; default
-    /// none, VoroLoss alone; 0.3 measured on smooth shapes).
+    /// Weight of the polish's alignment term (`soft_voronoi::polish::Alignment`): `None`
+    /// (default), on a closed input the aligned polish (weight 0.3) is tried beside the plain
+    /// one and its crust kept only where it is at least as good on all four metrics
+    /// ([`FitConfig::try_alignment`]); 0: the plain polish only (VoroLoss alone); W > 0:
+    /// always that weight.
     pub polish_align: Option<f64>,
 }
 
@@ -122,6 +125,7 @@ impl FitOptions {
             if let Some(w) = self.polish_align {
                 p.alignment =
                     (w > 0.0).then(|| soft_voronoi::polish::Alignment { normal_weight: w, ..Default::default() });
+                c.try_alignment = None;
             }
             (p.steps > 0).then_some(p)
         };

@@ -262,6 +262,9 @@ pub struct FitReport {
     pub refined_share: Option<f64>,
     /// The surface polish after training (absent when off or on a thin shell).
     pub polish: Option<soft_voronoi::PolishReport>,
+    /// The default's choice between the plain and the aligned polish on a closed input
+    /// (absent when it was not made: open input, thin shell, no polish, `--polish-align`).
+    pub polish_choice: Option<PolishChoice>,
     /// Trainable sites whose label was changed to the solid's at their final position
     /// (absent when relabelling was off).
     pub relabelled_sites: Option<usize>,
@@ -279,6 +282,121 @@ pub struct FitReport {
     pub outputs: OutputsReport,
     /// Wall time of the fit, seconds.
     pub total_seconds: f64,
+}
+
+/// The default's choice between the plain polish and the aligned one on a closed input
+/// (`run::choose_alignment`): both crusts, measured against the input as written.
+#[derive(Clone, Debug, Serialize)]
+pub struct PolishChoice {
+    /// The crust of the plain polish (VoroLoss alone); `None` when its metrics failed.
+    pub plain: Option<PolishScores>,
+    /// The crust of the aligned polish; `None` when it could not be built or measured.
+    pub aligned: Option<PolishScores>,
+    /// Why the aligned polish's crust could not be built (rounding to the output's
+    /// precision), when it could not.
+    pub aligned_error: Option<String>,
+    /// When the aligned attempt stopped before carving: both uncarved crusts' Chamfer
+    /// distance and normal consistency (unit-cube lengths), the aligned one short of the
+    /// plain one's on one of them.
+    pub before_carving: Option<BeforeCarving>,
+    /// Whether the aligned crust was kept: at least as good on all four and better on one.
+    pub aligned_kept: bool,
+    /// The input's bounding-box diagonal (mesh units), for shares of it.
+    pub diagonal: f64,
+    /// Wall time of the second polish, its crust and both measurements, seconds.
+    pub seconds: f64,
+}
+
+impl PolishScores {
+    /// At least as good as `other` on all four metrics and better on one.
+    pub fn no_worse_and_better_than(&self, other: &PolishScores) -> bool {
+        let (a, b) = (other, self);
+        let no_worse = b.hausdorff <= a.hausdorff
+            && b.chamfer_l1 <= a.chamfer_l1
+            && b.fscore >= a.fscore
+            && b.normal_consistency >= a.normal_consistency;
+        let better = b.hausdorff < a.hausdorff
+            || b.chamfer_l1 < a.chamfer_l1
+            || b.fscore > a.fscore
+            || b.normal_consistency > a.normal_consistency;
+        no_worse && better
+    }
+}
+
+impl PolishChoice {
+    /// For the summary: which crust was kept and why.
+    fn sentence(&self) -> String {
+        if let Some(b) = &self.before_carving {
+            return format!(
+                " The polish with the pairs turned along the normals was tried too and stopped before carving \
+                 (normal consistency {:.4} against {:.4}, Chamfer {:.3e} against {:.3e} in the unit cube).",
+                b.aligned.normal_consistency, b.plain.normal_consistency, b.aligned.chamfer_l1, b.plain.chamfer_l1
+            );
+        }
+        match (&self.plain, &self.aligned, &self.aligned_error) {
+            (_, _, Some(_)) => " The polish with the pairs turned along the normals was tried too; its crust could \
+                 not be written in the output's precision, so the plain one was kept (report: polish_choice)."
+                .into(),
+            (Some(a), Some(b), None) if self.aligned_kept => format!(
+                " Both polishes were run, plain and with the pairs turned along the normals; the aligned one's \
+                 crust was kept, at least as good on all four metrics (normal consistency {:.4} → {:.4}, \
+                 Hausdorff distance {:.3}% → {:.3}% of the diagonal).",
+                a.normal_consistency,
+                b.normal_consistency,
+                100.0 * a.hausdorff / self.diagonal,
+                100.0 * b.hausdorff / self.diagonal
+            ),
+            (Some(a), Some(b), None) => {
+                let worse: Vec<String> = [
+                    (b.hausdorff > a.hausdorff).then(|| {
+                        format!(
+                            "Hausdorff distance {:.3}% against {:.3}% of the diagonal",
+                            100.0 * b.hausdorff / self.diagonal,
+                            100.0 * a.hausdorff / self.diagonal
+                        )
+                    }),
+                    (b.chamfer_l1 > a.chamfer_l1)
+                        .then(|| format!("Chamfer {:.3e} against {:.3e}", b.chamfer_l1, a.chamfer_l1)),
+                    (b.fscore < a.fscore).then(|| format!("F-score {:.4} against {:.4}", b.fscore, a.fscore)),
+                    (b.normal_consistency < a.normal_consistency).then(|| {
+                        format!("normal consistency {:.4} against {:.4}", b.normal_consistency, a.normal_consistency)
+                    }),
+                ]
+                .into_iter()
+                .flatten()
+                .collect();
+                format!(
+                    " The polish with the pairs turned along the normals was tried too and not kept ({}).",
+                    if worse.is_empty() { "no metric better".to_string() } else { worse.join(", ") }
+                )
+            }
+            _ => " The polish with the pairs turned along the normals was tried too; its metrics could not be \
+                  compared, so the plain one was kept."
+                .into(),
+        }
+    }
+}
+
+/// See [`PolishChoice::before_carving`].
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct BeforeCarving {
+    /// The plain polish's uncarved crust.
+    pub plain: crate::carve::SurfaceBar,
+    /// The aligned polish's.
+    pub aligned: crate::carve::SurfaceBar,
+}
+
+/// The four metrics the choice compares (mesh units; F-score at 0.3% of the diagonal).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct PolishScores {
+    /// Certified Hausdorff distance, upper end of the interval.
+    pub hausdorff: f64,
+    /// Chamfer L1.
+    pub chamfer_l1: f64,
+    /// F-score.
+    pub fscore: f64,
+    /// Normal consistency.
+    pub normal_consistency: f64,
 }
 
 /// Farthest crust point from the input, as a share of its diagonal, from which the summary
@@ -368,9 +486,14 @@ impl FitReport {
         let carved = format!("{carved}{guarded}");
         let polished = match &self.polish {
             Some(p) => format!(
-                " The sites were then polished onto the surface samples ({} steps of VoroMesh's bisector loss, \
-                 {:.3e} → {:.3e}; sites moved {:.2e} rms).",
-                p.steps, p.loss_first, p.loss_last, p.move_rms
+                " The sites were then polished onto the surface samples ({} steps of VoroMesh's bisector loss{}, \
+                 {:.3e} → {:.3e}; sites moved {:.2e} rms).{}",
+                p.steps,
+                if p.aligned { " with the pairs turned along the surface normals over the first half" } else { "" },
+                p.loss_first,
+                p.loss_last,
+                p.move_rms,
+                self.polish_choice.as_ref().map_or(String::new(), PolishChoice::sentence)
             ),
             None => String::new(),
         };
@@ -543,7 +666,27 @@ pub fn wilson_interval(wrong: usize, n: usize) -> [f64; 2] {
 
 #[cfg(test)]
 mod tests {
-    use super::wilson_interval;
+    use super::{wilson_interval, PolishScores};
+
+    #[test]
+    fn the_aligned_crust_must_be_no_worse_on_all_four_and_better_on_one() {
+        let a = PolishScores { hausdorff: 0.01, chamfer_l1: 1e-4, fscore: 0.999, normal_consistency: 0.99 };
+        assert!(!a.no_worse_and_better_than(&a), "equal is not better");
+        let better_nc = PolishScores { normal_consistency: 0.995, ..a };
+        assert!(better_nc.no_worse_and_better_than(&a) && !a.no_worse_and_better_than(&better_nc));
+        // Better normals do not buy a worse value of any other metric.
+        for worse in [
+            PolishScores { hausdorff: 0.0101, ..better_nc },
+            PolishScores { chamfer_l1: 1.01e-4, ..better_nc },
+            PolishScores { fscore: 0.9989, ..better_nc },
+        ] {
+            assert!(!worse.no_worse_and_better_than(&a), "{worse:?}");
+        }
+        let all_better = PolishScores { hausdorff: 0.009, chamfer_l1: 0.9e-4, fscore: 1.0, normal_consistency: 0.991 };
+        assert!(all_better.no_worse_and_better_than(&a));
+        // A NaN never wins.
+        assert!(!PolishScores { hausdorff: f64::NAN, ..all_better }.no_worse_and_better_than(&a));
+    }
 
     #[test]
     fn wilson_interval_known_values() {

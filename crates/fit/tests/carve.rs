@@ -51,8 +51,29 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert!(before > 0.02, "the gap makes a spike: {before}");
     let tolerance = 0.004;
     let n0 = sites.len();
-    let options = CarveOptions { tolerance, rounds: 4, max_new: 400, mirrors: true };
+    let options = CarveOptions { tolerance, rounds: 4, max_new: 400, mirrors: true, gate: None };
+    let (start_sites, start_labels) = (sites.clone(), labels.clone());
     let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, &options).unwrap();
+    // The gate: an uncarved crust short of the bar (here, of an unreachable normal
+    // consistency) stops carving before its first round; one that reaches it carves as
+    // without a gate.
+    assert!(!report.gated);
+    let first = report.first_surface;
+    assert!(first.chamfer_l1 > 0.0 && first.normal_consistency > 0.9 && first.normal_consistency < 1.0, "{first:?}");
+    for (bar, gated) in [
+        (fit::carve::SurfaceBar { normal_consistency: first.normal_consistency + 1e-6, ..first }, true),
+        (fit::carve::SurfaceBar { chamfer_l1: first.chamfer_l1 * 0.999, ..first }, true),
+        (first, false),
+    ] {
+        let (mut s, mut l) = (start_sites.clone(), start_labels.clone());
+        let r = carve(&mut s, &mut l, &oracle, &unit, &solid, &CarveOptions { gate: Some(bar), ..options }).unwrap();
+        assert_eq!(r.gated, gated, "{bar:?}");
+        if gated {
+            assert!(r.inserted_per_round.is_empty() && s.len() == n0, "{r:?}");
+        } else {
+            assert_eq!((s, l), (sites.clone(), labels.clone()));
+        }
+    }
     let inserted: usize = report.inserted_per_round.iter().sum();
     assert_eq!(sites.len(), n0 + inserted);
     assert!(inserted > 0 && inserted % 2 == 0, "{report:?}");
@@ -160,7 +181,7 @@ fn pairs_at_input_far_from_the_crust_bring_a_lost_part_back() {
     let tolerance = 0.004;
     // The budget covers two rounds over the box: its first round's pairs (turned to bisect
     // the box's edges, not left out there) and their mirrors take 600 sites.
-    let options = CarveOptions { tolerance, rounds: 4, max_new: 900, mirrors: true };
+    let options = CarveOptions { tolerance, rounds: 4, max_new: 900, mirrors: true, gate: None };
     let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, &options).unwrap();
     let input = &report.input_farthest_per_round;
     let kept = report.inserted_per_round.len();

@@ -296,7 +296,9 @@ def fit(
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics,
-            polish_steps (0: no polish), polish_lr, polish_align (0: VoroLoss alone).
+            polish_steps (0: no polish), polish_lr, polish_align (None: on a closed mesh both
+            polishes, the aligned crust kept where it is at least as good on all four metrics;
+            0: VoroLoss alone; W > 0: always weight W).
 
     Returns:
         :class:`FitResult`.
