@@ -154,7 +154,7 @@ pub struct Args {
     /// Weight of the polish's alignment term over its first half (nearest inside and
     /// outside sites of each surface sample turned along its normal, which lines the pairs
     /// up, for smoother normals on smooth shapes). Default: on a closed input the polish
-    /// runs twice, without the term and with weight 0.3, and the aligned crust is kept only
+    /// runs twice, without the term and with weight 0.1, and the aligned crust is kept only
     /// if it is at least as good on all four metrics against the input (report:
     /// polish_choice); 0: VoroLoss alone, as VoroMesh (faster); W > 0: always weight W
     /// (README, *Lined-up pairs*).

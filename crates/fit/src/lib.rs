@@ -37,7 +37,7 @@ pub mod target;
 
 pub use config::{
     Checkpointing, EvalSampling, FitConfig, Sampling, SolidRule, DEFAULT_CARVE, DEFAULT_EVAL_SAMPLES, DEFAULT_SITES,
-    MARGIN,
+    MARGIN, TRY_ALIGNMENT_WEIGHT,
 };
 pub use crust_step::{crust_of, CheckedCrust};
 pub use error::FitError;

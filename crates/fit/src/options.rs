@@ -68,7 +68,7 @@ pub struct FitOptions {
     /// Polish learning rate (default 1e-3 at K = 8,192, scaled by √(8192/K)).
     pub polish_lr: Option<f64>,
     /// Weight of the polish's alignment term (`soft_voronoi::polish::Alignment`): `None`
-    /// (default), on a closed input the aligned polish (weight 0.3) is tried beside the plain
+    /// (default), on a closed input the aligned polish (weight [`crate::TRY_ALIGNMENT_WEIGHT`]) is tried beside the plain
     /// one and its crust kept only where it is at least as good on all four metrics
     /// ([`FitConfig::try_alignment`]); 0: the plain polish only (VoroLoss alone); W > 0:
     /// always that weight.
