@@ -9,7 +9,8 @@ mod common;
 use common::{bin, root, shared_meshes};
 
 /// Small and fast fit options for the tests.
-const FIT: [&str; 9] = ["--", "--sites", "256", "--steps", "20", "--samples", "20000", "--eval-samples", "2000"];
+const FIT: [&str; 11] =
+    ["--", "--sites", "256", "--steps", "20", "--samples", "20000", "--eval-samples", "2000", "--polish-steps", "100"];
 
 fn summary(dir: &Path) -> Vec<std::collections::HashMap<String, String>> {
     let text = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
@@ -128,6 +129,8 @@ fn a_killed_batch_resumes_from_the_checkpoint_to_the_same_result() {
         "50000",
         "--eval-samples",
         "2000",
+        "--polish-steps",
+        "100",
     ];
     // The uninterrupted result.
     let clean = tmp.path().join("clean");

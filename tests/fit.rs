@@ -7,8 +7,10 @@ use std::process::{Command, Output};
 mod common;
 use common::{bin, root, shared_meshes};
 
-/// Settings small enough for a test run.
-const QUICK: [&str; 8] = ["--sites", "1024", "--steps", "40", "--samples", "100000", "--eval-samples", "50000"];
+/// Settings small enough for a test run. The polish's 100 steps (400 by default) are most of
+/// such a fit's time, twice over on a closed input where both polishes are tried.
+const QUICK: [&str; 10] =
+    ["--sites", "1024", "--steps", "40", "--samples", "100000", "--eval-samples", "50000", "--polish-steps", "100"];
 
 fn fit(mesh: &Path, out: &Path, extra: &[&str]) -> Output {
     bin().arg(mesh).arg("-o").arg(out).arg("--quiet").args(extra).output().unwrap()

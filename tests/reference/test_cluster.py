@@ -19,7 +19,7 @@ import pytest
 from conftest import ROOT, SHARED, run
 
 VENV_BIN = Path(sys.executable).parent
-OPTS = ["--sites", "256", "--steps", "80", "--samples", "20000", "--eval-samples", "2000"]
+OPTS = ["--sites", "256", "--steps", "80", "--samples", "20000", "--eval-samples", "2000", "--polish-steps", "100"]
 
 
 def free_port():

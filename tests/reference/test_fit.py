@@ -20,7 +20,7 @@ MESHES = [ROOT / "assets" / "bunny.obj", SHARED / "mikedh__multibody.stl", SHARE
 def test_sites_file_reproduces_reported_misclassification(bin_path, tmp_path, mesh):
     out = tmp_path / "fit.glb"
     run(mesh, "-o", out, "--sites", "2048", "--steps", "100", "--samples", "200000", "--eval-samples", "200000",
-        "--quiet")
+        "--polish-steps", "100", "--quiet")
     report = json.loads((tmp_path / "fit.report.json").read_text())
     s = np.load(tmp_path / "fit.sites.npz")
     sites, labels, T = s["sites"], s["labels"].astype(bool), s["transform"]

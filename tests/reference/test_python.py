@@ -29,8 +29,8 @@ import voronoi_fit as vf
 from conftest import ROOT, SHARED, assert_gltf_valid, run
 
 BUNNY = ROOT / "assets" / "bunny.obj"
-SMALL = dict(sites=512, steps=30, samples=20000, eval_samples=2000)
-SMALL_CLI = ["--sites", "512", "--steps", "30", "--samples", "20000", "--eval-samples", "2000"]
+SMALL = dict(sites=512, steps=30, samples=20000, eval_samples=2000, polish_steps=100)
+SMALL_CLI = ["--sites", "512", "--steps", "30", "--samples", "20000", "--eval-samples", "2000", "--polish-steps", "100"]
 
 
 @pytest.fixture(scope="module")

@@ -26,7 +26,7 @@ def quick_fit(tmp_path_factory):
     d = tmp_path_factory.mktemp("view")
     out = d / "bunny.glb"
     run(ROOT / "assets" / "bunny.obj", "-o", out, "--sites", "1024", "--steps", "40",
-        "--samples", "100000", "--eval-samples", "20000", "--quiet", "--html")
+        "--samples", "100000", "--eval-samples", "20000", "--polish-steps", "100", "--quiet", "--html")
     return out
 
 

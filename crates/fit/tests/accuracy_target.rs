@@ -2,6 +2,8 @@
 //! crust missed, until the certified Hausdorff meets the goal or the budget is spent; the
 //! report carries the K used and the error-against-K trace.
 
+mod common;
+
 use fit::{fit_to_accuracy, AccuracyGoal, FitConfig, FitError, NoProgress};
 use mesh_io::shapes::icosphere;
 
@@ -20,12 +22,7 @@ fn closest(trace: &[fit::grow::GrowthRow]) -> &fit::grow::GrowthRow {
 }
 
 fn small(k: usize) -> FitConfig {
-    let mut c = FitConfig::new("sphere", k);
-    c.train.steps = 60;
-    c.train.batch = 4096;
-    c.sampling.samples = 60_000;
-    c.eval.samples = 20_000;
-    c
+    common::small("sphere", k, 60, 60_000, 20_000)
 }
 
 #[test]

@@ -2,6 +2,8 @@
 //! points of that cap become surface samples, so the crust there follows the level set
 //! instead of fanning out from the hole's rim.
 
+mod common;
+
 use fit::{FitConfig, NoProgress, SolidRule};
 use mesh_io::shapes::icosphere;
 use mesh_io::TriMesh;
@@ -9,12 +11,7 @@ use occupancy::distance::closest_point_triangle::closest_point_segment;
 use occupancy::{Config, MeshOracle, WindingMode};
 
 fn small(name: &str) -> FitConfig {
-    let mut c = FitConfig::new(name, 2048);
-    c.train.steps = 80;
-    c.train.batch = 4096;
-    c.sampling.samples = 200_000;
-    c.eval.samples = 40_000;
-    c
+    common::small(name, 2048, 80, 200_000, 40_000)
 }
 
 /// A unit sphere without its cap above z = 0.5 (a hole of radius 0.87).

@@ -2,18 +2,15 @@
 //! triangles all face inward and a soup of unconnected triangles fit like the ordinary
 //! sphere, and the report's IoU agrees (it used w ≥ 0.5 before and said 0 for them).
 
+mod common;
+
 use fit::{FitConfig, NoProgress};
 use mesh_io::shapes::icosphere;
 use mesh_io::TriMesh;
 use occupancy::{Config, MeshOracle, WindingMode, Workspace};
 
 fn small(name: &str) -> FitConfig {
-    let mut c = FitConfig::new(name, 512);
-    c.train.steps = 60;
-    c.train.batch = 4096;
-    c.sampling.samples = 40_000;
-    c.eval.samples = 40_000;
-    c
+    common::small(name, 512, 60, 40_000, 40_000)
 }
 
 fn inverted(m: &TriMesh) -> TriMesh {

@@ -3,6 +3,8 @@
 //! initialisation, the surface term and the polish, and the report says how much of the
 //! surface that was.
 
+mod common;
+
 use fit::{FitConfig, NoProgress};
 use mesh_io::shapes::cuboid;
 use mesh_io::TriMesh;
@@ -18,12 +20,7 @@ fn concat(a: &TriMesh, b: &TriMesh) -> TriMesh {
 const SAMPLES: usize = 50_000;
 
 fn small(name: &str) -> FitConfig {
-    let mut c = FitConfig::new(name, 512);
-    c.train.steps = 20;
-    c.train.batch = 4096;
-    c.sampling.samples = SAMPLES;
-    c.eval.samples = 20_000;
-    c
+    common::small(name, 512, 20, SAMPLES, 20_000)
 }
 
 #[test]

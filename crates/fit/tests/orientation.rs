@@ -3,17 +3,14 @@
 //! the fit would reproduce the wrong solid (a wedge out of one face on the benchmark's
 //! multibody, Hausdorff 12.7% of the diagonal).
 
+mod common;
+
 use fit::{FitConfig, NoProgress};
 use mesh_io::shapes::cuboid;
 use mesh_io::TriMesh;
 
 fn small(name: &str) -> FitConfig {
-    let mut c = FitConfig::new(name, 512);
-    c.train.steps = 20;
-    c.train.batch = 4096;
-    c.sampling.samples = 50_000;
-    c.eval.samples = 20_000;
-    c
+    common::small(name, 512, 20, 50_000, 20_000)
 }
 
 #[test]

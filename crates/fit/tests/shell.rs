@@ -2,17 +2,14 @@
 //! (the surface thickened by a band, stated in the report) instead of being refused; closed
 //! meshes keep the winding-number solid; a mesh with no area is still refused.
 
+mod common;
+
 use fit::{FitConfig, FitError, NoProgress, SolidRule};
 use mesh_io::shapes::icosphere;
 use mesh_io::TriMesh;
 
 fn small(name: &str) -> FitConfig {
-    let mut c = FitConfig::new(name, 1024);
-    c.train.steps = 80;
-    c.train.batch = 4096;
-    c.sampling.samples = 60_000;
-    c.eval.samples = 40_000;
-    c
+    common::small(name, 1024, 80, 60_000, 40_000)
 }
 
 /// An n×n grid of squares (two triangles each) on the unit square, z = 0.

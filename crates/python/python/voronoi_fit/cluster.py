@@ -301,12 +301,18 @@ def main(argv: Optional[list[str]] = None) -> int:
     ap.add_argument("--steps", type=int)
     ap.add_argument("--samples", type=int)
     ap.add_argument("--eval-samples", type=int)
+    ap.add_argument("--polish-steps", type=int, help="steps of the surface polish (0: none; default as the CLI's)")
+    ap.add_argument(
+        "--polish-align",
+        type=float,
+        help="alignment weight of the polish (0: plain polish only, faster; default: both tried on closed meshes)",
+    )
     ap.add_argument("--retries", type=int, default=3, help="runs of a task whose worker died (Ray max_retries)")
     ap.add_argument("--cpus-per-task", type=float, default=1.0)
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     options = {"sites": a.sites, "seed": a.seed}
-    for k in ("steps", "samples", "eval_samples"):
+    for k in ("steps", "samples", "eval_samples", "polish_steps", "polish_align"):
         if getattr(a, k) is not None:
             options[k] = getattr(a, k)
     rows = run(a.ray, a.manifest, a.out, options, a.retries, a.cpus_per_task, a.quiet)
