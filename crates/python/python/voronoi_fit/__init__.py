@@ -297,7 +297,8 @@ def fit(
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics,
             polish_steps (0: no polish), polish_lr, polish_align (None: on a closed mesh both
-            polishes, the aligned crust kept where it is at least as good on all four metrics;
+            polishes, the aligned crust kept where it is at least as good on all four metrics,
+            Hausdorff distances both within the F-score's tau counting as equal;
             0: VoroLoss alone; W > 0: always weight W).
 
     Returns:
