@@ -156,8 +156,8 @@ pub struct Args {
     /// up, for smoother normals on smooth shapes). Default: on a closed input the polish
     /// runs twice, without the term and with weight 0.1, and the aligned crust is kept only
     /// if it is at least as good on all four metrics against the input (Hausdorff
-    /// distances both within the F-score's τ, 0.3% of the diagonal, count as equal; report:
-    /// polish_choice); 0: VoroLoss alone, as VoroMesh (faster); W > 0: always weight W
+    /// distances both within the F-score's τ, 0.3% of the diagonal, or with overlapping
+    /// certified intervals count as equal; report: polish_choice); 0: VoroLoss alone, as VoroMesh (faster); W > 0: always weight W
     /// (README, *Lined-up pairs*).
     #[arg(long)]
     pub polish_align: Option<f64>,

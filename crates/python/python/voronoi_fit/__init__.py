@@ -298,7 +298,8 @@ def fit(
             solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics,
             polish_steps (0: no polish), polish_lr, polish_align (None: on a closed mesh both
             polishes, the aligned crust kept where it is at least as good on all four metrics,
-            Hausdorff distances both within the F-score's tau counting as equal;
+            Hausdorff distances both within the F-score's tau or with overlapping certified
+            intervals counting as equal;
             0: VoroLoss alone; W > 0: always weight W).
 
     Returns:
