@@ -302,8 +302,8 @@ pub struct PolishChoice {
     /// plain one's on one of them.
     pub before_carving: Option<BeforeCarving>,
     /// Whether the aligned crust was kept: at least as good on all four and better on one
-    /// (Hausdorff distances both within the F-score's τ count as equal;
-    /// [`PolishScores::no_worse_and_better_than`]).
+    /// (Hausdorff distances both within the F-score's τ, or whose certified intervals
+    /// overlap, count as equal; [`PolishScores::no_worse_and_better_than`]).
     pub aligned_kept: bool,
     /// The input's bounding-box diagonal (mesh units), for shares of it.
     pub diagonal: f64,
