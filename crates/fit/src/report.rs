@@ -345,7 +345,7 @@ impl PolishScores {
     /// - certified intervals that overlap: the certificate cannot tell them apart (where a
     ///   part of the input buried in its solid sets both at the same floor: trimesh's
     ///   rabbit.obj, 7.8536% of the diagonal for both, upper ends 7e-7 of the diagonal
-    ///   apart with intervals about 1e-6 wide).
+    ///   apart with intervals under 1e-6 wide).
     ///
     /// Otherwise greater only when this interval lies wholly above the other's, less only
     /// when wholly below.
