@@ -405,3 +405,64 @@ fn glb_with_tiny_declared_length_is_an_error_not_a_panic() {
     let e = read_mesh(&write(d.path(), "tiny.glb", &b)).unwrap_err();
     assert_eq!((e.kind, e.location), (ErrorKind::Syntax, Location::Byte(8)));
 }
+
+/// A 2 × 2 grid of unit squares in the plane z = 0 as triangle strips: one strip per row
+/// of squares, the rows separated by -1, and a zero-area joint (a repeated vertex) inside
+/// the second strip that must not become a face.
+fn tristrip_ply(format: &str) -> Vec<u8> {
+    let v = |r: i32, c: i32| r * 3 + c;
+    let strips: Vec<i32> = vec![
+        v(0, 0), v(1, 0), v(0, 1), v(1, 1), v(0, 2), v(1, 2), -1,
+        v(1, 0), v(2, 0), v(1, 1), v(2, 1), v(1, 2), v(2, 2), v(2, 2),
+    ];
+    let mut b = format!(
+        "ply\nformat {format} 1.0\nelement vertex 9\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+    )
+    .into_bytes();
+    for r in 0..3 {
+        for c in 0..3 {
+            if format == "ascii" {
+                b.extend_from_slice(format!("{c} {r} 0\n").as_bytes());
+            } else {
+                for x in [c as f32, r as f32, 0.0] {
+                    b.extend_from_slice(&x.to_le_bytes());
+                }
+            }
+        }
+    }
+    if format == "ascii" {
+        let ids: Vec<String> = strips.iter().map(|i| i.to_string()).collect();
+        b.extend_from_slice(format!("{} {}\n", strips.len(), ids.join(" ")).as_bytes());
+    } else {
+        b.extend_from_slice(&(strips.len() as i32).to_le_bytes());
+        for i in &strips {
+            b.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    b
+}
+
+#[test]
+fn ply_triangle_strips_become_consistently_oriented_triangles() {
+    let d = tmp();
+    for f in ["ascii", "binary_little_endian"] {
+        let m = read_mesh(&write(d.path(), &format!("strips_{f}.ply"), &tristrip_ply(f))).unwrap();
+        assert_eq!(m.triangles.len(), 8, "{f}: {:?}", m.triangles);
+        let mut area = 0.0;
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            // z of (b - a) × (c - a): every triangle of the strip faces the same way
+            let z = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(z < 0.0, "{f}: triangle {t:?} is flipped against the first");
+            area -= z / 2.0;
+        }
+        assert_eq!(area, 4.0, "{f}");
+        let r = TopologyReport::of(&m);
+        assert!(r.is_manifold && r.is_orientation_consistent && r.num_boundary_loops == 1, "{f}: {r:?}");
+    }
+    // a vertex id past the end is named with the element
+    let bad = String::from_utf8(tristrip_ply("ascii")).unwrap().replace("\n14 0 3", "\n14 0 9");
+    let e = read_mesh(&write(d.path(), "bad_strip.ply", bad.as_bytes())).unwrap_err();
+    assert_eq!(e.kind, ErrorKind::IndexOutOfRange, "{e}");
+    assert!(e.to_string().contains("tristrips 0 refers to vertex 9"), "{e}");
+}

@@ -96,23 +96,26 @@ struct Layout {
     vertex: usize,
     /// Indices of the x, y, z properties within it.
     xyz: [usize; 3],
-    /// Index of the `face` element and of its vertex-index list property, if any.
+    /// Index of the `face` (or `tristrips`) element and of its vertex-index list
+    /// property, if any.
     face: Option<(usize, usize)>,
+    /// The faces are triangle strips (`tristrips`), not polygons.
+    strips: bool,
 }
 
 impl Layout {
     fn of(elements: &[Element], path: &Path) -> Result<Layout> {
         let (vertex, xyz) = vertex_layout(elements, path)?;
-        let face = face_layout(elements, path)?;
-        if face.is_some_and(|(f, _)| f < vertex) {
+        let (face, strips) = face_layout(elements, path)?;
+        if let Some((f, _)) = face.filter(|&(f, _)| f < vertex) {
             return Err(MeshError::new(
                 ErrorKind::Unsupported,
                 path,
                 Location::File,
-                "the `face` element comes before the `vertex` element",
+                format!("the `{}` element comes before the `vertex` element", elements[f].name),
             ));
         }
-        Ok(Layout { vertex, xyz, face })
+        Ok(Layout { vertex, xyz, face, strips })
     }
 }
 
@@ -144,18 +147,16 @@ fn vertex_layout(elements: &[Element], path: &Path) -> Result<(usize, [usize; 3]
 }
 
 /// The `face` element and its list property `vertex_indices` (or `vertex_index`), if the
-/// file has faces; triangle strips are refused.
-fn face_layout(elements: &[Element], path: &Path) -> Result<Option<(usize, usize)>> {
-    let Some(face) = elements.iter().position(|e| e.name == "face") else {
-        if elements.iter().any(|e| e.name == "tristrips") {
-            return Err(MeshError::new(
-                ErrorKind::Unsupported,
-                path,
-                Location::File,
-                "the file stores triangle strips (`tristrips`), not faces",
-            ));
-        }
-        return Ok(None);
+/// file has faces; failing that, the `tristrips` element (Stanford's scans, e.g. igea.ply,
+/// store their triangles as strips: one list of vertex ids, -1 between strips), with
+/// `true` for strips.
+fn face_layout(elements: &[Element], path: &Path) -> Result<(Option<(usize, usize)>, bool)> {
+    let (face, strips) = match elements.iter().position(|e| e.name == "face") {
+        Some(f) => (f, false),
+        None => match elements.iter().position(|e| e.name == "tristrips") {
+            Some(f) => (f, true),
+            None => return Ok((None, false)),
+        },
     };
     let prop = elements[face]
         .props
@@ -166,10 +167,10 @@ fn face_layout(elements: &[Element], path: &Path) -> Result<Option<(usize, usize
                 ErrorKind::Syntax,
                 path,
                 Location::File,
-                "the `face` element has no list property `vertex_indices`",
+                format!("the `{}` element has no list property `vertex_indices`", elements[face].name),
             )
         })?;
-    Ok(Some((face, prop)))
+    Ok((Some((face, prop)), strips))
 }
 
 /// Refuse counts the remaining bytes cannot hold (at least one byte per element per
@@ -241,12 +242,15 @@ impl Body {
         path: &Path,
     ) -> Result<()> {
         let n = reader.scalar(count, &el.name, i, path)?;
-        if !(0.0..=1.0e6).contains(&n) || n.fract() != 0.0 {
+        // A polygon has at most a million corners; a strip may hold a whole mesh (its
+        // values are read one by one, so a length the file cannot hold fails as truncated)
+        let max_len = if is_faces && self.layout.strips { u32::MAX as f64 } else { 1.0e6 };
+        if !(0.0..=max_len).contains(&n) || n.fract() != 0.0 {
             return Err(reader.error(
                 &el.name,
                 i,
                 path,
-                &format!("list length {n} is not a whole number between 0 and 1,000,000"),
+                &format!("list length {n} is not a whole number between 0 and {max_len}"),
             ));
         }
         self.poly.clear();
@@ -256,20 +260,39 @@ impl Body {
             if !is_faces {
                 continue;
             }
+            if self.layout.strips && v == -1.0 {
+                strip(&self.poly, &mut self.mesh.triangles);
+                self.poly.clear();
+                continue;
+            }
             if v < 0.0 || v.fract() != 0.0 || v >= num_positions as f64 {
                 return Err(MeshError::new(
                     ErrorKind::IndexOutOfRange,
                     path,
                     reader.location(&el.name, i),
-                    format!("face {i} refers to vertex {v} but the file has {num_positions} vertices"),
+                    format!("{} {i} refers to vertex {v} but the file has {num_positions} vertices", el.name),
                 ));
             }
             self.poly.push(v as u32);
         }
-        if is_faces {
+        if is_faces && self.layout.strips {
+            strip(&self.poly, &mut self.mesh.triangles);
+        } else if is_faces {
             super::fan(&self.poly, &mut self.mesh.triangles);
         }
         Ok(())
+    }
+}
+
+/// The triangles of one strip: triangle k is (s[k], s[k+1], s[k+2]) with every second one
+/// reversed so that all keep the first one's orientation. Triangles with a repeated vertex
+/// are the zero-area joints strips use to turn corners, not faces, and are left out.
+fn strip(s: &[u32], out: &mut Vec<[u32; 3]>) {
+    for (k, w) in s.windows(3).enumerate() {
+        let t = if k % 2 == 0 { [w[0], w[1], w[2]] } else { [w[1], w[0], w[2]] };
+        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+            out.push(t);
+        }
     }
 }
 
