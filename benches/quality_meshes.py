@@ -72,6 +72,7 @@ MESHES = [
     MeshSpec("box_fin", "synth", "box_fin", "box + thin fin (1% of the diagonal) as two overlapping closed bodies", "z", "generated"),
     MeshSpec("cad_union", "synth", "cad_union", "fandisk-like: boxes, a wedge and cylinders as overlapping closed bodies", "z", "generated"),
     MeshSpec("open_sheet", "synth", "open_sheet", "one open wavy sheet (no inside at all)", "z", "generated"),
+    MeshSpec("chair", "synth", "chair", "slatted chair of 15 overlapping closed boxes: back slats 1.0% of the diagonal thick, stretchers 1.7%", "y", "generated"),
 ]
 BY_NAME = {m.name: m for m in MESHES}
 QUICK = ["spot", "multibody", "box_fin"]
@@ -166,6 +167,15 @@ def synth(name):
             transform=T.translation_matrix([0.62, 0, 0.3]) @ T.rotation_matrix(np.radians(45), [0, 1, 0]),
         )
         parts.append(wedge)
+        return _concat(parts)
+    if name == "chair":
+        # the issue's "chair slats": parts thinner than the sites' spacing at K = 8,192
+        parts = [_box([0.5, 0.04, 0.5], [0, 0.45, 0])]  # seat
+        parts += [_box([0.035, 0.45, 0.035], [x, 0.225, z]) for x in (-0.23, 0.23) for z in (-0.23, 0.23)]  # legs
+        parts += [_box([0.035, 0.5, 0.035], [x, 0.72, -0.23]) for x in (-0.23, 0.23)]  # back posts
+        parts += [_box([0.03, 0.42, 0.012], [-0.16 + 0.08 * i, 0.68, -0.23]) for i in range(5)]  # slats
+        parts.append(_box([0.5, 0.05, 0.03], [0, 0.95, -0.23]))  # top rail
+        parts += [_box([0.46, 0.02, 0.02], [0, 0.12, z]) for z in (-0.23, 0.23)]  # stretchers
         return _concat(parts)
     if name == "open_sheet":
         n = 60
