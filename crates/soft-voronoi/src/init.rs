@@ -285,8 +285,8 @@ pub fn pairs_init_refined(
 /// faces, p − (w/2)·u and p + (3w/2)·u. Each face is then exactly the bisector of the middle
 /// site and its mirror, and as every column carries both, a flat plate comes out flat
 /// whatever the spacing (mirrored pairs from its two faces do not line up, and crumple it).
-/// A column costs 3 sites against a pair's 2, so two thirds of the thin pairs become columns
-/// (the first ones, in the candidates' random order) and the rest are dropped, keeping K.
+/// A column costs 3 sites against a pair's 2, so about two thirds of the thin pairs become
+/// columns (a well-spread subset of them) and the rest are dropped, keeping K.
 /// Returns pair index → its column, or `None` for a dropped pair.
 #[allow(clippy::too_many_arguments)]
 fn thin_columns(
@@ -348,12 +348,23 @@ fn thin_columns(
     // Only parts thinner than the pair was meant to be wide become columns.
     which.retain(|&j| 0.5 * (lo[j] + hi[j]) < 2.0 * offset * r0);
     let budget = k.saturating_sub(2 * (chosen.len() - which.len())) / 3;
+    // The columns kept are a well-spread subset of the thin pairs' feet (Poisson-disk, the
+    // widest spacing that leaves `budget`), not the first ones in the pairs' order: that
+    // order puts the pairs rescued onto the thinnest parts last, so it dropped them all
+    // when the budget ran short (a slatted chair at K = 2,048: 108 pairs on its slats, 0
+    // kept, and the slats were lost).
+    let kept: std::collections::HashSet<u32> = if which.len() > budget {
+        let feet: Vec<[f64; 3]> = which.iter().map(|&j| frame[j].0).collect();
+        poisson_subset(&feet, budget).0.into_iter().collect()
+    } else {
+        (0..which.len() as u32).collect()
+    };
     which
         .into_iter()
         .enumerate()
         .map(|(n, j)| {
             let w = 0.5 * (lo[j] + hi[j]);
-            (thin[j], (n < budget).then(|| [at(j, 0.5 * w), at(j, -0.5 * w), at(j, 1.5 * w)]))
+            (thin[j], kept.contains(&(n as u32)).then(|| [at(j, 0.5 * w), at(j, -0.5 * w), at(j, 1.5 * w)]))
         })
         .collect()
 }
