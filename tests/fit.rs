@@ -54,6 +54,12 @@ fn main_job_runs_on_every_shared_mesh_and_asset() {
         assert!((0.0..bound).contains(&mis), "{name}: misclassification {mis}");
         assert!(out.with_extension("sites.npz").exists());
         assert!(!out.with_extension("ckpt.npz").exists(), "{name}: the checkpoint is removed after a finished run");
+        // The sites file reproduces the crust to the byte: `voronoi-fit crust` maps by the
+        // file's matrix, and so does the fit.
+        let again = dir.path().join(format!("{name}.again.glb"));
+        let o = bin().arg("crust").arg(out.with_extension("sites.npz")).arg("-o").arg(&again).output().unwrap();
+        assert!(o.status.success(), "{name}: {}", String::from_utf8_lossy(&o.stderr));
+        assert!(std::fs::read(&again).unwrap() == std::fs::read(&out).unwrap(), "{name}: the crust of the sites file differs");
         // The crust is in the input's frame: its box is close to the input's (for the
         // simple closed shapes; an open mesh's inside region can reach the cube's faces).
         if !simple {

@@ -2,6 +2,7 @@
 
 use std::time::Instant;
 
+use crust::output::FrameMap;
 use crust::SitesFile;
 use mesh_io::{TopologyReport, TriMesh, UnitCubeTransform};
 use occupancy::sample::SurfaceSampler;
@@ -301,7 +302,12 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
             }
             let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
             let mirrored = carving.as_ref().is_some_and(|r| r.inserted_as_mirrors_per_round.iter().sum::<usize>() > 0);
-            match crust_of(&sites, &labels, &p.transform, config.output_precision) {
+            // Mapped by the sites file's own matrix, evaluated as `crust::SitesFile` and
+            // `voronoi-fit crust` evaluate it, so the crust of the written sites is this crust
+            // to the bit (mapping by centre and scale rounds differently, and a merge of
+            // vertices a few float steps apart could then go the other way).
+            let map = FrameMap::Matrix(p.transform.from_unit_matrix());
+            match crust_of(&sites, &labels, map, config.output_precision) {
                 Ok(checked) => {
                     timings.crust += lap.next();
                     return Ok(Ok(Attempt {
