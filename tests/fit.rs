@@ -59,7 +59,10 @@ fn main_job_runs_on_every_shared_mesh_and_asset() {
         let again = dir.path().join(format!("{name}.again.glb"));
         let o = bin().arg("crust").arg(out.with_extension("sites.npz")).arg("-o").arg(&again).output().unwrap();
         assert!(o.status.success(), "{name}: {}", String::from_utf8_lossy(&o.stderr));
-        assert!(std::fs::read(&again).unwrap() == std::fs::read(&out).unwrap(), "{name}: the crust of the sites file differs");
+        assert!(
+            std::fs::read(&again).unwrap() == std::fs::read(&out).unwrap(),
+            "{name}: the crust of the sites file differs"
+        );
         // The crust is in the input's frame: its box is close to the input's (for the
         // simple closed shapes; an open mesh's inside region can reach the cube's faces).
         if !simple {

@@ -412,8 +412,20 @@ fn glb_with_tiny_declared_length_is_an_error_not_a_panic() {
 fn tristrip_ply(format: &str) -> Vec<u8> {
     let v = |r: i32, c: i32| r * 3 + c;
     let strips: Vec<i32> = vec![
-        v(0, 0), v(1, 0), v(0, 1), v(1, 1), v(0, 2), v(1, 2), -1,
-        v(1, 0), v(2, 0), v(1, 1), v(2, 1), v(1, 2), v(2, 2), v(2, 2),
+        v(0, 0),
+        v(1, 0),
+        v(0, 1),
+        v(1, 1),
+        v(0, 2),
+        v(1, 2),
+        -1,
+        v(1, 0),
+        v(2, 0),
+        v(1, 1),
+        v(2, 1),
+        v(1, 2),
+        v(2, 2),
+        v(2, 2),
     ];
     let mut b = format!(
         "ply\nformat {format} 1.0\nelement vertex 9\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n"
