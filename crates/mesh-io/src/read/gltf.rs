@@ -379,24 +379,13 @@ fn read_primitive(
         let (a, b, c) = (a + base as u32, b + base as u32, c + base as u32);
         mesh.triangles.push(if flip { [a, c, b] } else { [a, b, c] });
     };
+    let mut local = Vec::new();
     match mode {
-        Mode::Triangles => indices.chunks_exact(3).for_each(|t| push(t[0], t[1], t[2])),
-        Mode::TriangleStrip => {
-            for k in 0..indices.len().saturating_sub(2) {
-                let (a, b, c) = (indices[k], indices[k + 1], indices[k + 2]);
-                if k % 2 == 0 {
-                    push(a, b, c)
-                } else {
-                    push(b, a, c)
-                }
-            }
-        }
-        Mode::TriangleFan => {
-            for k in 1..indices.len().saturating_sub(1) {
-                push(indices[0], indices[k], indices[k + 1]);
-            }
-        }
+        Mode::Triangles => local.extend(indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]])),
+        Mode::TriangleStrip => super::strip(&indices, &mut local),
+        Mode::TriangleFan => super::fan(&indices, &mut local),
         _ => {}
     }
+    local.into_iter().for_each(|[a, b, c]| push(a, b, c));
     Ok(())
 }

@@ -166,6 +166,18 @@ pub(crate) fn fan(poly: &[u32], out: &mut Vec<[u32; 3]>) {
     }
 }
 
+/// The triangles of one strip: triangle k is (s[k], s[k+1], s[k+2]) with every second one
+/// reversed so that all keep the first one's orientation. Triangles with a repeated vertex
+/// are the zero-area joints strips use to turn corners, not faces, and are left out.
+pub(crate) fn strip(s: &[u32], out: &mut Vec<[u32; 3]>) {
+    for (k, w) in s.windows(3).enumerate() {
+        let t = if k % 2 == 0 { [w[0], w[1], w[2]] } else { [w[1], w[0], w[2]] };
+        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+            out.push(t);
+        }
+    }
+}
+
 /// Convert a vertex count to u32 or say the mesh is too large.
 pub(crate) fn check_vertex_count(n: usize, path: &Path) -> Result<()> {
     if n > u32::MAX as usize {

@@ -261,7 +261,7 @@ impl Body {
                 continue;
             }
             if self.layout.strips && v == -1.0 {
-                strip(&self.poly, &mut self.mesh.triangles);
+                super::strip(&self.poly, &mut self.mesh.triangles);
                 self.poly.clear();
                 continue;
             }
@@ -276,23 +276,11 @@ impl Body {
             self.poly.push(v as u32);
         }
         if is_faces && self.layout.strips {
-            strip(&self.poly, &mut self.mesh.triangles);
+            super::strip(&self.poly, &mut self.mesh.triangles);
         } else if is_faces {
             super::fan(&self.poly, &mut self.mesh.triangles);
         }
         Ok(())
-    }
-}
-
-/// The triangles of one strip: triangle k is (s[k], s[k+1], s[k+2]) with every second one
-/// reversed so that all keep the first one's orientation. Triangles with a repeated vertex
-/// are the zero-area joints strips use to turn corners, not faces, and are left out.
-fn strip(s: &[u32], out: &mut Vec<[u32; 3]>) {
-    for (k, w) in s.windows(3).enumerate() {
-        let t = if k % 2 == 0 { [w[0], w[1], w[2]] } else { [w[1], w[0], w[2]] };
-        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
-            out.push(t);
-        }
     }
 }
 
