@@ -12,6 +12,7 @@ type V = [f64; 3];
 /// What the checker measured.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CrustCheck {
+    /// The crust's topology (closed, manifold, components, genus, orientation).
     pub report: TopologyReport,
     /// Triangle pairs whose bounding boxes overlap and that share no vertex position.
     pub num_pairs_tested: usize,

@@ -5,16 +5,40 @@
 pub enum CrustError {
     /// `sites` and `labels` differ in length.
     #[error("{num_sites} sites but {num_labels} labels; give one label per site")]
-    LengthMismatch { num_sites: usize, num_labels: usize },
+    LengthMismatch {
+        /// Sites given.
+        num_sites: usize,
+        /// Labels given.
+        num_labels: usize,
+    },
     /// A site coordinate is NaN or infinite.
     #[error("site {index} is {position:?}, not finite; remove or repair it")]
-    NonFinite { index: usize, position: [f64; 3] },
+    NonFinite {
+        /// The site's index.
+        index: usize,
+        /// Its coordinates as given.
+        position: [f64; 3],
+    },
     /// A site is not strictly inside the domain box.
     #[error("site {index} at {position:?} is not strictly inside the domain box {lo:?}..{hi:?}; move it inside (training clamps sites) or enlarge the box")]
-    OutsideBox { index: usize, position: [f64; 3], lo: [f64; 3], hi: [f64; 3] },
+    OutsideBox {
+        /// The site's index.
+        index: usize,
+        /// Its coordinates.
+        position: [f64; 3],
+        /// The box's lower corner.
+        lo: [f64; 3],
+        /// The box's upper corner.
+        hi: [f64; 3],
+    },
     /// The domain box is empty or not finite.
     #[error("the domain box {lo:?}..{hi:?} is empty or not finite")]
-    BadBox { lo: [f64; 3], hi: [f64; 3] },
+    BadBox {
+        /// The box's lower corner.
+        lo: [f64; 3],
+        /// The box's upper corner.
+        hi: [f64; 3],
+    },
     /// The Delaunay tetrahedralization failed.
     #[error("Delaunay tetrahedralization of the sites failed: {0}")]
     Delaunay(#[from] delaunay3::DelaunayError),
@@ -33,10 +57,23 @@ pub enum CrustError {
 /// Why a sites file could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum SitesFileError {
+    /// The file cannot be read.
     #[error("{path}: cannot read the file ({source})")]
-    Io { path: String, source: std::io::Error },
+    Io {
+        /// The sites file.
+        path: String,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The file's contents are not a sites file (missing or malformed arrays).
     #[error("{path}: {message}")]
-    Invalid { path: String, message: String },
+    Invalid {
+        /// The sites file.
+        path: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// Writing the file failed.
     #[error(transparent)]
     Write(#[from] mesh_io::MeshError),
 }

@@ -28,12 +28,15 @@ impl Default for CrustConfig {
 /// What the extraction did, for reports.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CrustStats {
+    /// Sites given (inside and outside).
     pub num_sites: usize,
+    /// Sites labelled inside.
     pub num_inside: usize,
     /// Mirror images of inside sites added across the box faces (see [`Crust::extract`]).
     pub num_mirrors: usize,
     /// 1, or 2 when mirrors were needed.
     pub num_delaunay_passes: usize,
+    /// Finite tetrahedra of the (last) Delaunay pass.
     pub num_finite_tets: usize,
     /// Voronoi faces in the crust (polygons before triangulation).
     pub num_polygons: usize,
@@ -47,7 +50,9 @@ pub struct CrustStats {
     pub num_merged_vertices: usize,
     /// The largest crust-edge length (max-norm) merged to repair rounding, 0 when none.
     pub merge_distance: f64,
+    /// Wall time of the Delaunay passes.
     pub delaunay_seconds: f64,
+    /// Wall time of the whole extraction, checks included.
     pub total_seconds: f64,
 }
 
@@ -59,6 +64,7 @@ pub struct Crust {
     /// - `mesh.positions`: #V×3 f64 Voronoi vertices (circumcentres);
     /// - `mesh.triangles`: #F×3 u32, counter-clockwise seen from outside.
     pub mesh: TriMesh,
+    /// What the extraction did.
     pub stats: CrustStats,
     /// The exact checker's report on `mesh` ([`crate::check::check_crust`]), which it
     /// passed: extraction checks what it returns.

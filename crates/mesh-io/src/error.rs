@@ -44,7 +44,12 @@ pub enum Location {
     /// A byte offset into a binary file.
     Byte(u64),
     /// The `index`-th (0-based) element of a kind, such as `face 12` or `vertex 3`.
-    Element { kind: &'static str, index: usize },
+    Element {
+        /// The element's kind, such as `face` or `vertex`.
+        kind: &'static str,
+        /// Its 0-based index.
+        index: usize,
+    },
 }
 
 impl fmt::Display for Location {
@@ -63,8 +68,11 @@ impl fmt::Display for Location {
 /// Displayed as one paragraph: `FILE, LOCATION: what is wrong. What to do.`
 #[derive(Debug)]
 pub struct MeshError {
+    /// What class of problem it is (it decides the default hint and the exit code).
     pub kind: ErrorKind,
+    /// The file.
     pub path: PathBuf,
+    /// Where in the file.
     pub location: Location,
     /// What is wrong, without the file name.
     pub message: String,
@@ -74,6 +82,7 @@ pub struct MeshError {
 }
 
 impl MeshError {
+    /// An error of `kind` at `location` in `path`, with the kind's default hint.
     pub fn new(kind: ErrorKind, path: &Path, location: Location, message: impl Into<String>) -> Self {
         MeshError {
             kind,
@@ -91,6 +100,7 @@ impl MeshError {
         self
     }
 
+    /// The file cannot be read.
     pub fn io(path: &Path, err: std::io::Error) -> Self {
         let message = format!("cannot read the file ({err})");
         let mut e = MeshError::new(ErrorKind::Io, path, Location::File, message);
@@ -98,6 +108,7 @@ impl MeshError {
         e
     }
 
+    /// The file cannot be written.
     pub fn write(path: &Path, err: std::io::Error) -> Self {
         let message = format!("cannot write the file ({err})");
         let mut e = MeshError::new(ErrorKind::Write, path, Location::File, message);

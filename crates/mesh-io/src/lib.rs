@@ -46,7 +46,9 @@ pub use write::{
 /// [`TriMesh::validate`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriMesh {
+    /// Vertex positions.
     pub positions: Vec<[f64; 3]>,
+    /// Triangles as three vertex indices, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
 }
 

@@ -21,6 +21,7 @@ pub struct TopologyReport {
     pub num_vertices: usize,
     /// Vertices used by at least one face.
     pub num_referenced_vertices: usize,
+    /// Triangles.
     pub num_faces: usize,
     /// Distinct undirected edges.
     pub num_edges: usize,
@@ -54,9 +55,11 @@ pub struct TopologyReport {
     /// file's units cubed; positive for a closed mesh oriented counter-clockwise seen from
     /// outside. For an open mesh it depends on where the origin is.
     pub signed_volume: f64,
+    /// Total triangle area, in the file's units squared.
     pub surface_area: f64,
-    /// Bounding box of the referenced vertices.
+    /// Bounding box of the referenced vertices: lower corner.
     pub bbox_min: [f64; 3],
+    /// Upper corner.
     pub bbox_max: [f64; 3],
 }
 

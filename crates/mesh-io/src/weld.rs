@@ -65,7 +65,9 @@ pub struct WeldStats {
     pub relative_tolerance: f64,
     /// The same in the mesh's units: `relative_tolerance × diagonal`.
     pub absolute_tolerance: f64,
+    /// Vertices before the weld.
     pub vertices_before: usize,
+    /// Vertices after it.
     pub vertices_after: usize,
     /// Triangles removed because two or more of their corners became one vertex (any
     /// triangle that already had a repeated vertex is removed and counted too).

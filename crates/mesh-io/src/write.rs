@@ -19,6 +19,7 @@ use crate::TriMesh;
 pub struct SceneMesh<'a> {
     /// Node and mesh name.
     pub name: &'a str,
+    /// The triangles.
     pub mesh: &'a TriMesh,
     /// Optional per-vertex colours: #V×3 f32 linear RGB in [0, 1] (clamped on write).
     pub colors: Option<&'a [[f32; 3]]>,

@@ -44,16 +44,57 @@ impl TextSize {
 pub enum Shape {
     /// A filled convex polygon (non-convex ones are drawn as a fan from the first point in
     /// the PNG).
-    Polygon { points: Vec<(f64, f64)>, fill: Rgb },
+    Polygon {
+        /// Vertices, in drawing units.
+        points: Vec<(f64, f64)>,
+        /// Fill colour.
+        fill: Rgb,
+    },
     /// An open polyline (repeat the first point to close it).
-    Polyline { points: Vec<(f64, f64)>, width: f64, color: Rgb },
+    Polyline {
+        /// Vertices, in drawing units.
+        points: Vec<(f64, f64)>,
+        /// Line width, in drawing units.
+        width: f64,
+        /// Colour.
+        color: Rgb,
+    },
     /// A filled disc.
-    Disc { center: (f64, f64), radius: f64, fill: Rgb },
+    Disc {
+        /// Centre, in drawing units.
+        center: (f64, f64),
+        /// Radius, in drawing units.
+        radius: f64,
+        /// Fill colour.
+        fill: Rgb,
+    },
     /// Text centred vertically on `pos`, anchored at its left end, centre or right end.
-    Text { pos: (f64, f64), text: String, size: TextSize, anchor: Anchor, color: Rgb },
+    Text {
+        /// Anchor position, in drawing units.
+        pos: (f64, f64),
+        /// The text.
+        text: String,
+        /// Font size.
+        size: TextSize,
+        /// Which point of the text sits at `pos`.
+        anchor: Anchor,
+        /// Colour.
+        color: Rgb,
+    },
     /// A grey-scale image of `cols` × `rows` values (0 = black, 255 = white, row-major,
     /// top row first) drawn into the rectangle at `origin` of size `size`, nearest-pixel.
-    Gray { origin: (f64, f64), size: (f64, f64), cols: usize, rows: usize, values: Vec<u8> },
+    Gray {
+        /// Top-left corner, in drawing units.
+        origin: (f64, f64),
+        /// Width and height, in drawing units.
+        size: (f64, f64),
+        /// Values per row.
+        cols: usize,
+        /// Rows.
+        rows: usize,
+        /// Grey levels, row-major, top row first.
+        values: Vec<u8>,
+    },
 }
 
 /// Horizontal anchoring of [`Shape::Text`].

@@ -158,6 +158,10 @@ pub fn boundary_grid_size(count: usize) -> Option<usize> {
     (count > 0).then(|| ((count as f64 / 6.0).sqrt().ceil() as usize).max(1))
 }
 
+/// What [`pairs_init`] returns: the sites, their labels and r0, the uniform spacing of the
+/// pairs away from thin parts (unit-cube lengths).
+pub type PairsInit = (Vec<[f64; 3]>, Vec<bool>, f64);
+
 /// Well-spread mirrored pairs: about K/2 surface points chosen by greedy Poisson-disk
 /// sampling (a minimum distance r found by bisection so the count is K/2; candidates are
 /// the first 12·K of `data.surface`, already area-uniform and random), each giving the
@@ -176,7 +180,7 @@ pub fn pairs_init(
     solid: &dyn Solid,
     offset: f64,
     seed: u64,
-) -> Result<(Vec<[f64; 3]>, Vec<bool>, f64), TrainError> {
+) -> Result<PairsInit, TrainError> {
     pairs_init_refined(k, data, solid, offset, seed, &[])
 }
 
@@ -194,7 +198,7 @@ pub fn pairs_init_refined(
     offset: f64,
     seed: u64,
     refine: &[bool],
-) -> Result<(Vec<[f64; 3]>, Vec<bool>, f64), TrainError> {
+) -> Result<PairsInit, TrainError> {
     let pairs = k / 2;
     let n = data.surface.len();
     if n < pairs.max(2) || data.normals.len() != n {

@@ -11,6 +11,10 @@ use crate::knn::{self, KnnTree};
 /// Samples per parallel chunk (fixed: the reduction order depends on it).
 pub const CHUNK: usize = 1024;
 
+/// One chunk's share of a loss: its summed loss and its sparse gradient contributions
+/// (site index, gradient), reduced in chunk order by [`reduce`].
+pub(crate) type ChunkPart<const D: usize> = (f64, Vec<(u32, [f64; D])>);
+
 /// Reconstruction loss (1/N) Σ_i |O(x_i) − V(x_i)| over a batch, and its gradient added
 /// (times `weight`) into `grad` for the first `grad.len()` sites (the trainable ones;
 /// later sites — fixed boundary sites — get none).
@@ -49,7 +53,7 @@ pub fn reconstruction_hinted<const D: usize>(
 ) -> f64 {
     let n = points.len().max(1) as f64;
     let trainable = grad.len() as u32;
-    let parts: Vec<(f64, Vec<(u32, [f64; D])>)> = points
+    let parts: Vec<ChunkPart<D>> = points
         .par_chunks(CHUNK)
         .zip(occupancy.par_chunks(CHUNK))
         .zip(hints.par_chunks_mut(CHUNK))
@@ -75,7 +79,7 @@ pub fn reconstruction_hinted<const D: usize>(
 /// Per-chunk partial losses and gradient contributions, summed in chunk order (so the
 /// result does not depend on the thread count); the contributions times `factor` are
 /// added into `grad`. Returns the summed loss.
-fn reduce<const D: usize>(parts: Vec<(f64, Vec<(u32, [f64; D])>)>, factor: f64, grad: &mut [[f64; D]]) -> f64 {
+fn reduce<const D: usize>(parts: Vec<ChunkPart<D>>, factor: f64, grad: &mut [[f64; D]]) -> f64 {
     let mut loss = 0.0;
     for (l, contributions) in parts {
         loss += l;
@@ -379,7 +383,7 @@ pub fn surface_hinted(
 ) -> f64 {
     let m = points.len().max(1) as f64;
     let trainable = grad.len() as u32;
-    let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
+    let parts: Vec<ChunkPart<3>> = points
         .par_chunks(CHUNK)
         .zip(normals.par_chunks(CHUNK))
         .zip(hints.par_chunks_mut(CHUNK))

@@ -34,6 +34,11 @@ use vf_common::AdamParams;
 
 use crate::error::TrainError;
 
+/// A surface sample's bisector with one neighbour: (signed distance, the neighbour's
+/// index, unit direction from the nearest site to it, the sample's offset from their
+/// midpoint, their distance).
+type Bisector = (f64, usize, [f64; 3], [f64; 3], f64);
+
 /// Samples per parallel chunk (fixed, so the sums do not depend on the thread count).
 const CHUNK: usize = 1024;
 
@@ -220,7 +225,7 @@ pub fn voroloss(sites: &[[f64; 3]], points: &[[f64; 3]], neighbours: usize, grad
     let want = (neighbours + 1).min(sites.len());
     let trainable = grad.len();
     let n = points.len() as f64;
-    let parts: Vec<(f64, Vec<(u32, [f64; 3])>)> = points
+    let parts: Vec<crate::losses::ChunkPart<3>> = points
         .par_chunks(CHUNK)
         .map(|xs| {
             let mut out = Vec::with_capacity(2 * xs.len());
@@ -231,7 +236,9 @@ pub fn voroloss(sites: &[[f64; 3]], points: &[[f64; 3]], neighbours: usize, grad
                 tree.k_nearest(x, want, &mut near);
                 let i = near[0].1 as usize;
                 let pi = sites[i];
-                let mut best: Option<(f64, usize, [f64; 3], [f64; 3], f64)> = None;
+                // (signed distance to the bisector, j, unit edge direction, offset from the
+                // edge's midpoint, edge length) of the nearest bisector so far.
+                let mut best: Option<Bisector> = None;
                 for &(_, j) in &near[1..] {
                     let pj = sites[j as usize];
                     let e = [pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]];

@@ -374,7 +374,7 @@ impl<'a> Trainer<'a> {
     /// [`TrainError::Diverged`] on a non-finite loss or site; Delaunay failures.
     pub fn step(&mut self) -> Result<StepStats, TrainError> {
         let every = self.state.config.select_every;
-        if every > 0 && self.state.step % every == 0 {
+        if every > 0 && self.state.step.is_multiple_of(every) {
             self.consider_current();
         }
         let stats = self.update()?;
@@ -392,7 +392,7 @@ impl<'a> Trainer<'a> {
         let w = cfg.weights.clone();
         let (lr, beta) = (cfg.lr_at(t), cfg.beta_at(t));
         let kernel = Kernel { beta, tau: cfg.tau };
-        if t % cfg.refresh_every == 0 || (w.centroidal > 0.0 && st.graph.num_sites() != st.sites.len()) {
+        if t.is_multiple_of(cfg.refresh_every) || (w.centroidal > 0.0 && st.graph.num_sites() != st.sites.len()) {
             if w.centroidal > 0.0 {
                 st.graph = SiteGraph::delaunay(&st.sites)?;
             }

@@ -12,7 +12,7 @@ const BETAS: [f64; 6] = [10.0, 100.0, 1_000.0, 10_000.0, 30_000.0, 100_000.0];
 fn config(k: usize, n: usize, beta: f64, seed: u64) -> (Vec<[f64; 3]>, Vec<bool>, Vec<[f64; 3]>) {
     let mut rng = ChunkRng::for_chunk(seed, Stream::Test, 7);
     let sites: Vec<[f64; 3]> = (0..k).map(|_| [rng.uniform(), rng.uniform(), rng.uniform()]).collect();
-    let labels: Vec<bool> = (0..k).map(|_| rng.next_u64() % 2 == 0).collect();
+    let labels: Vec<bool> = (0..k).map(|_| rng.next_u64().is_multiple_of(2)).collect();
     let index = SiteIndex::new(&sites);
     let mut points = Vec::new();
     while points.len() < n {

@@ -5,7 +5,10 @@ use soft_voronoi::kernel::{self, Kernel, Scratch, SiteIndex};
 use soft_voronoi::losses::{self, Located, SiteGraph};
 use vf_common::{ChunkRng, Stream};
 
-fn setup(k: usize, n: usize, seed: u64) -> (Vec<[f64; 2]>, Vec<bool>, Vec<[f64; 2]>, Vec<bool>) {
+/// Sites, their labels, points and their occupancy.
+type Setup = (Vec<[f64; 2]>, Vec<bool>, Vec<[f64; 2]>, Vec<bool>);
+
+fn setup(k: usize, n: usize, seed: u64) -> Setup {
     let mut rng = ChunkRng::for_chunk(seed, Stream::Test, 2000);
     let sites: Vec<[f64; 2]> = (0..k).map(|_| [rng.uniform(), rng.uniform()]).collect();
     let labels: Vec<bool> = (0..k).map(|i| i % 2 == 0).collect();

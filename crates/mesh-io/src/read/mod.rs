@@ -22,9 +22,13 @@ use crate::TriMesh;
 /// The input formats [`read_mesh`] understands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Wavefront OBJ (tobj).
     Obj,
+    /// STL, ASCII or binary.
     Stl,
+    /// PLY, ASCII or binary (either byte order).
     Ply,
+    /// OFF (Object File Format).
     Off,
     /// glTF 2.0, JSON (`.gltf`) or binary (`.glb`): the reader tells them apart by content.
     Gltf,

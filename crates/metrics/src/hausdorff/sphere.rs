@@ -132,7 +132,7 @@ fn check_sphere(sphere: &Sphere, tol: f64) -> Result<(), MetricsError> {
             sphere.radius
         )));
     }
-    if !(tol >= 0.0) {
+    if tol.is_nan() || tol < 0.0 {
         return Err(MetricsError::BadOption(format!("tolerance {tol} must be a number ≥ 0")));
     }
     Ok(())

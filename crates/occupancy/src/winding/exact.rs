@@ -125,6 +125,8 @@ impl Caps {
     }
 }
 
+/// The boundary chains of every BVH node's triangles (on welded vertices), for the exact
+/// winding number's far-field caps.
 pub fn build_caps(bvh: &TriangleBvh) -> Caps {
     let num_nodes = bvh.num_nodes();
     let (ids, points) = welded_ids(&bvh.corners);
