@@ -15,6 +15,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
+STARTED=$(date +%s)
 TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
 LOG=$TARGET/test-logs
 mkdir -p "$LOG"
@@ -116,5 +117,10 @@ if [ ${#step_failed[@]} -gt 0 ]; then
   echo "failed steps: ${step_failed[*]}"
   failed=$((failed + ${#step_failed[@]}))
 fi
+# A machine-readable record of this run (benches/results/test_suite.json is a committed
+# copy of one, the source of the docs' test count and suite time).
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+printf '{"command": "bash tests/run.sh", "commit": "%s", "date": "%s", "passed": %d, "failed": %d, "seconds": %d, "cargo_passed": %d, "pytest_passed": %d}\n' \
+  "$commit" "$(date -u +%Y-%m-%dT%H:%M:%SZ)" "$passed" "$failed" "$(( $(date +%s) - STARTED ))" "${cp:-0}" "${pp:-0}" > "$LOG/suite.json"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
