@@ -3,8 +3,8 @@
 Standard library and pytest only: `python3 -m pytest tests/reference/test_docs.py -q`
 (VF_ROOT, if set, is the repository root).
 
-Checked documents: README.md and docs/*.md (figures and links), CHANGELOG.md (links only:
-it is history, its numbers are those of past builds).
+Checked documents: README.md, docs/*.md and assets/README.md (figures and links),
+CHANGELOG.md (links only: it is history, its numbers are those of past builds).
 
 Conventions (docs/reports.md, *Figures in the documentation*):
 
@@ -49,8 +49,8 @@ from pathlib import Path
 
 ROOT = Path(os.environ.get("VF_ROOT", Path(__file__).resolve().parents[2]))
 
-FIGURE_DOCS = ["README.md", "docs/*.md"]
-LINK_DOCS = ["README.md", "CHANGELOG.md", "docs/*.md"]
+FIGURE_DOCS = ["README.md", "docs/*.md", "assets/README.md"]
+LINK_DOCS = ["README.md", "CHANGELOG.md", "docs/*.md", "assets/README.md"]
 
 MARKER = re.compile(r"<!--\s*figures\s+(\{.*?\})\s*-->", re.S)
 NO_FIGURES = re.compile(r"<!--\s*no-figures:.*?-->", re.S)
@@ -296,6 +296,8 @@ def check_table(root, where, header, body, spec, seen):
 def check_inline(root, where, text, seen):
     errs = []
     for m in INLINE.finditer(text):
+        if text[max(0, m.start() - 1):m.start()] == "`":
+            continue  # a marker quoted as code, not a marker
         file, sel = m.group(1), m.group(2)
         lineno = text.count("\n", 0, m.start()) + 1
         before = numbers(text[max(0, m.start() - 40):m.start()])
