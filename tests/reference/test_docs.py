@@ -420,6 +420,27 @@ def test_every_relative_link_resolves():
     assert not errs, "\n".join(errs)
 
 
+HELP_PAGES = ["", "batch", "view", "info", "convert", "sample", "query", "delaunay", "crust", "eval", "study",
+              "mnist train", "mnist eval", "mnist tsne", "mnist interpolate", "mnist run", "mnist bench"]
+
+
+def test_every_flag_of_the_cli_is_documented():
+    """Every long option `--help` lists appears in docs/cli.md (skipped without a built binary)."""
+    import pytest
+
+    binary = Path(os.environ.get("VF_BIN", ROOT / "target" / "ci" / "voronoi-fit"))
+    if not binary.is_file():
+        pytest.skip(f"no binary at {binary}")
+    cli = (ROOT / "docs" / "cli.md").read_text()
+    missing = []
+    for page in HELP_PAGES:
+        r = subprocess.run([str(binary), *page.split(), "--help"], capture_output=True, text=True, check=True)
+        for flag in sorted(set(re.findall(r"(?<![\w-])--[a-z][a-z0-9-]+", r.stdout))):
+            if flag not in ("--help",) and flag not in cli:
+                missing.append(f"voronoi-fit {page} {flag}".replace("  ", " "))
+    assert not missing, "flags missing from docs/cli.md:\n" + "\n".join(missing)
+
+
 def _altered_copy(doc, old, new):
     """A copy of doc with the first occurrence of old (on a marked line) replaced."""
     text = doc.read_text()
