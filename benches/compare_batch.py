@@ -11,7 +11,7 @@ target/bench-batch/: `batch --jobs 1`, `batch --jobs 2`, and the Ray runner on a
 cluster with two task slots (`--ray local`, started inside the runner, so its start-up
 counts). Each fit uses all of the machine's threads whatever the slot count (rayon's pool;
 Ray's CPU count only limits how many tasks run at once). Writes
-benches/batch_results.md.
+benches/results/batch_results.md.
 """
 import argparse
 import json
@@ -31,7 +31,7 @@ def main():
     ap.add_argument("--sites", default="2048")
     ap.add_argument("--steps", default="300")
     ap.add_argument("--eval-samples", default="200000")
-    ap.add_argument("--out", type=Path, default=ROOT / "benches" / "batch_results.md")
+    ap.add_argument("--out", type=Path, default=ROOT / "benches" / "results" / "batch_results.md")
     a = ap.parse_args()
     exe = ROOT / "target" / "ci" / "voronoi-fit"
     meshes = sorted(p for p in a.meshes.iterdir() if p.suffix.lower() in {".obj", ".stl", ".ply", ".off", ".glb", ".gltf"})

@@ -73,7 +73,7 @@ machines). Install it into a venv of its own (2.15.0 is what this was run with):
 
     python3 -m venv target/bench-torch
     target/bench-torch/bin/pip install torch==2.15.0 numpy scipy
-    target/bench-torch/bin/python benches/compare_mnist.py --json benches/mnist_throughput.json
+    target/bench-torch/bin/python benches/compare_mnist.py --json benches/results/mnist_throughput.json
 """
 import argparse
 import gzip

@@ -40,10 +40,11 @@ and `interior_share` (eval's `solid_boundary`: the Hausdorff distance with the i
 that lie inside its own solid left out, a sampled estimate; the share of such faces), which
 tell a union's buried faces apart from a method's error.
 
-Output: DIR/quality_results.csv and DIR/quality_results.md (DIR = benches/ unless --out),
+Output: DIR/quality_results.csv and DIR/quality_results.md (DIR = benches/results/ unless --out),
 one row per mesh x K x method, a summary of medians per method, and PNG renders of input
 and outputs (DIR/quality_renders/, by benches/render.py). The provenance of the meshes is
-printed and written to benches/QUALITY_MESHES.md. Failed runs are recorded with their error
+printed and written to benches/results/QUALITY_MESHES.md. The CSV's `output` column is
+relative to the work folder (--work). Failed runs are recorded with their error
 and the benchmark goes on. Runs are sequential (the machine has 2 cores; each tool uses
 both). Work files: target/quality-cache/runs/MESH/K/METHOD/; `--reuse` takes a previous
 result whose settings are identical instead of running it again; `--cached-only` runs
@@ -388,7 +389,13 @@ def write_outputs(a, rows, methods, renders, header):
         w = csv.DictWriter(f, fieldnames=FIELDS, extrasaction="ignore")
         w.writeheader()
         for r in rows:
-            w.writerow(r)
+            rel = dict(r)
+            if rel.get("output"):
+                try:
+                    rel["output"] = os.path.relpath(rel["output"], a.work)
+                except ValueError:
+                    pass
+            w.writerow(rel)
     md = [
         "# Surface-quality benchmark results",
         "",
@@ -465,7 +472,7 @@ def main():
     ap.add_argument("--ours-bin", help="voronoi-fit for the ours runs (default --bin)")
     ap.add_argument("--ours-args", default="", help='extra flags for the ours runs, e.g. "--steps 1200"')
     ap.add_argument("--voromesh-args", default="", help="extra flags for benches/voromesh_ref.py")
-    ap.add_argument("--out", default=str(HERE), help="folder of quality_results.{md,csv} and quality_renders/")
+    ap.add_argument("--out", default=str(HERE / "results"), help="folder of quality_results.{md,csv} and quality_renders/")
     ap.add_argument("--work", default=str(WORK), help="work files (outputs of every run)")
     ap.add_argument("--reuse", action="store_true", help="reuse earlier results with identical settings")
     ap.add_argument("--cached-only", action="store_true",
@@ -507,7 +514,7 @@ def main():
     specs_all = qm.prepare(list(qm.BY_NAME), a.bin)
     infos = {s.name: qm.mesh_info(a.bin, s.path) for s in specs_all}
     print("Meshes:\n" + qm.provenance_markdown(specs_all, infos) + "\n")
-    qm.write_provenance(specs_all, infos, HERE / "QUALITY_MESHES.md")
+    qm.write_provenance(specs_all, infos, HERE / "results" / "QUALITY_MESHES.md")
     specs = [qm.BY_NAME[n] for n in names if n in qm.BY_NAME]
     unknown = [n for n in names if n not in qm.BY_NAME]
     if unknown:

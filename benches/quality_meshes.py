@@ -6,7 +6,7 @@ shared by the benchmark scripts.
     target/bench-venv/bin/python benches/quality_meshes.py [--meshes NAME,...]
 
 prepares the meshes (cached in target/quality-cache/meshes), prints the provenance table
-and writes it to benches/QUALITY_MESHES.md. `quality.py` does the same on every run.
+and writes it to benches/results/QUALITY_MESHES.md. `quality.py` does the same on every run.
 
 Three sources, all kept as they are (holes, cracks, soups, inconsistent winding, open
 sheets: the "ugly" inputs stay ugly):
@@ -295,7 +295,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--meshes", default=",".join(BY_NAME), help="comma-separated names")
     ap.add_argument("--bin", default=str(ROOT / "target" / "ci" / "voronoi-fit"))
-    ap.add_argument("--out", default=str(ROOT / "benches" / "QUALITY_MESHES.md"))
+    ap.add_argument("--out", default=str(ROOT / "benches" / "results" / "QUALITY_MESHES.md"))
     a = ap.parse_args()
     specs = prepare(a.meshes.split(","), a.bin)
     infos = {s.name: mesh_info(a.bin, s.path) for s in specs}
