@@ -131,7 +131,7 @@ impl TrainConfig {
     /// Checks the settings.
     ///
     /// # Errors
-    /// [`BaselineError::Config`](crate::BaselineError::Config) naming the setting.
+    /// [`BaselineError::Config`] naming the setting.
     pub fn validate(&self) -> Result<()> {
         if self.batch == 0 {
             return config_err("batch", self.batch, "a batch needs at least one point");

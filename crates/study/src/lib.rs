@@ -11,7 +11,7 @@
 //! of the exact signed distance on the decoders' grid. Surfaces: the Voronoi crust (exact,
 //! watertight) and marching cubes of the decoders. Distances: a certified Hausdorff
 //! interval to the analytic sphere ([`metrics::hausdorff_sphere_certified`]) and a sampled
-//! Chamfer L1 distance ([`measure`]). [`run`] returns the [`Row`]s; [`write`] writes
+//! Chamfer L1 distance ([`measure`]). [`run`] returns the [`Row`]s; [`write`](mod@write) writes
 //! results.csv, summary.csv, the plot, table.md and budget.json atomically;
 //! [`run_study`] does both into an output folder from [`StudyOptions`], as
 //! `voronoi-fit study sphere` runs it.

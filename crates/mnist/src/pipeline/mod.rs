@@ -2,7 +2,7 @@
 //! checkpoints that resume ([`train`]), the table on the test set ([`evaluate`]), the tSNE
 //! of the codes ([`tsne`]), the latent interpolation and reconstructions
 //! ([`interpolate`]), all of them in one go ([`run`]), and the training throughput
-//! ([`bench`]).
+//! ([`bench()`]).
 //!
 //! Each command takes plain option structs (no command-line parsing here), reads the data
 //! through a [`DataSource`], writes its files into the [`Experiment`]'s output folder
