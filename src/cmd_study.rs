@@ -1,5 +1,5 @@
-//! `voronoi-fit study sphere [--quick] --out DIR`: the sphere study (crates/study) with a
-//! progress bar and a closing summary.
+//! `voronoi-fit study sphere [--quick] --out DIR`: the arguments of the sphere study, run
+//! by `study::run_study` (crates/study), with a progress bar and a closing summary.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -46,9 +46,10 @@ fn parse_size(s: &str) -> Result<(usize, usize), String> {
     Ok((w, d))
 }
 
+/// The study's progress on the terminal: a bar (none with `--quiet`), failed runs and
+/// warnings above it.
 struct Bar {
     bar: indicatif::ProgressBar,
-    out: PathBuf,
 }
 
 impl study::StudyProgress for Bar {
@@ -60,62 +61,44 @@ impl study::StudyProgress for Bar {
         if let Some(r) = rows.last().filter(|r| r.is_failed()) {
             self.bar.suspend(|| eprintln!("voronoi-fit: {} {} (seed {}): {}", r.method, r.size, r.seed, r.convergence));
         }
-        // Saved as it goes: an interrupted study keeps every finished run.
-        if let Err(e) = study::write::write_csv(&self.out, rows) {
-            self.bar.suspend(|| eprintln!("voronoi-fit: cannot save results.csv so far: {e}"));
-        }
+    }
+    fn warning(&mut self, message: &str) {
+        self.bar.suspend(|| eprintln!("voronoi-fit: {message}"));
     }
 }
 
 pub fn run(args: Args) -> Result<(), CliError> {
     let t_all = Instant::now();
-    let mut budget = if args.quick { study::Budget::quick() } else { study::Budget::full() };
-    if let Some(seeds) = args.seeds.filter(|s| !s.is_empty()) {
-        budget.seeds = seeds;
-    }
-    if let Some(sites) = args.sites {
-        if let Some(&k) = sites.iter().find(|&&k| !(2..=1 << 20).contains(&k)) {
-            return Err(CliError::input(format!("--sites {k}: every site count must be in 2..=1048576")));
-        }
-        budget.voronoi_sites = sites;
-    }
-    if let Some(sizes) = args.mlp_sizes {
-        budget.mlp_sizes = sizes;
-    }
-    if let Some(only) = &args.only {
-        let has = |p: &str| only.iter().any(|o| o == p);
-        budget.voronoi = has("voronoi");
-        budget.decoders.retain(|d| has(d));
-        budget.references = has("references");
-    }
-    let meshes = args.out.join("meshes");
-    std::fs::create_dir_all(&meshes)
-        .map_err(|e| CliError::failure(format!("{}: cannot create the output directory ({e})", args.out.display())))?;
+    let options = study::StudyOptions {
+        quick: args.quick,
+        seeds: args.seeds,
+        only: args.only,
+        sites: args.sites,
+        mlp_sizes: args.mlp_sizes,
+    };
+    let budget = options.budget()?;
     let runs = study::num_units(&budget) as u64;
     let bar = if args.quiet { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(runs) };
     bar.set_style(
         indicatif::ProgressStyle::with_template("study {bar:30} {pos}/{len} runs, {msg}, {elapsed} (ETA {eta})")
             .map_err(anyhow::Error::from)?,
     );
-    let mut progress = Bar { bar, out: args.out.clone() };
-    let rows = study::run(&budget, &meshes, &mut progress)?;
+    let mut progress = Bar { bar };
+    let outcome = study::run_study(&args.out, &budget, args.quick, &mut progress);
     progress.bar.finish_and_clear();
-    let seconds = t_all.elapsed().as_secs_f64();
-    study::write::write(&args.out, &rows, &budget, args.quick, seconds)?;
-    let failed: Vec<String> =
-        rows.iter().filter(|r| r.is_failed()).map(|r| format!("{} {} (seed {})", r.method, r.size, r.seed)).collect();
-    let leaky = rows.iter().filter(|r| r.method == "voronoi" && !r.is_failed() && !r.watertight).count();
+    let outcome = outcome?;
+    let failed = outcome.failed();
     crate::output::out!(
         "study sphere ({}): {} runs and references over seeds {:?} in {:.1} s; wrote {}/results.csv, summary.csv, \
          hausdorff_vs_params.svg/.png, table.md, budget.json and meshes/ (seed {}). Every Voronoi crust is watertight: \
          {}.",
         if args.quick { "quick" } else { "full" },
-        rows.len(),
+        outcome.rows.len(),
         budget.seeds,
         t_all.elapsed().as_secs_f64(),
         args.out.display(),
         budget.seeds[0],
-        if leaky == 0 { "yes" } else { "NO" }
+        if outcome.leaky_crusts() == 0 { "yes" } else { "NO" }
     );
     if !failed.is_empty() {
         return Err(CliError::failure(format!(

@@ -3,7 +3,7 @@
 //!
 //! Entry points: [`DecoderConfig`] → [`Decoder::new`] (`Mlp<f32>`), [`train()`] (or
 //! [`Trainer`] step by step) on [`TrainingData`] with a [`TrainConfig`],
-//! [`Mlp::eval_grid`], [`marching_cubes`], [`extract_mesh`].
+//! [`Mlp::eval_grid`], [`marching_cubes()`], [`extract_mesh`].
 //!
 //! # Why the network is written by hand
 //!

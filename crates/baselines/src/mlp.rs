@@ -30,6 +30,7 @@ pub enum DecoderKind {
 /// Shape and loss of a decoder.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DecoderConfig {
+    /// OccNet or DeepSDF: the output and the loss.
     pub kind: DecoderKind,
     /// Units per hidden layer (≥ 1).
     pub width: usize,
@@ -204,6 +205,7 @@ impl<T: Real> Mlp<T> {
         Ok(model)
     }
 
+    /// The decoder's shape and loss.
     pub fn config(&self) -> &DecoderConfig {
         &self.config
     }
@@ -218,6 +220,7 @@ impl<T: Real> Mlp<T> {
         &self.params
     }
 
+    /// All parameters, flat and writable (the layout of [`Mlp::params`]).
     pub fn params_mut(&mut self) -> &mut [T] {
         &mut self.params
     }

@@ -28,6 +28,7 @@ use vf_common::AdamParams;
 /// analytically (the sphere study).
 #[derive(Clone, Debug, Default)]
 pub struct TrainingData {
+    /// The sample points.
     pub points: Vec<[f64; 3]>,
     /// Occupancy in [0, 1] (1 inside), for OccNet.
     pub occupancy: Option<Vec<f64>>,
@@ -75,14 +76,18 @@ impl TrainingData {
 /// Learning-rate schedule over the steps `0..steps`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Schedule {
+    /// `lr` throughout.
     Constant,
     /// Multiply by `factor` every `every` steps (DeepSDF: 0.5 every 500 epochs).
     Step {
+        /// Steps between reductions.
         every: usize,
+        /// Factor of each reduction.
         factor: f64,
     },
     /// Cosine from `lr` down to `min_lr` at the last step.
     Cosine {
+        /// The rate at the last step.
         min_lr: f64,
     },
 }
@@ -90,16 +95,21 @@ pub enum Schedule {
 /// How to train.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrainConfig {
+    /// Steps (one Adam update each).
     pub steps: usize,
     /// Points per step; a batch at least as large as the data set uses all of it every
     /// step, otherwise batches are consecutive slices of a seeded permutation redrawn every
     /// epoch (the remainder of an epoch is dropped).
     pub batch: usize,
+    /// Adam's initial learning rate.
     pub lr: f64,
+    /// How the rate changes over the steps.
     pub schedule: Schedule,
+    /// Seed of the batch permutations.
     pub seed: u64,
     /// Rows per parallel chunk (fixes the summation order; 4,096 by default).
     pub chunk_rows: usize,
+    /// Adam's constants.
     pub adam: AdamParams,
 }
 
@@ -118,6 +128,10 @@ impl Default for TrainConfig {
 }
 
 impl TrainConfig {
+    /// Checks the settings.
+    ///
+    /// # Errors
+    /// [`BaselineError::Config`] naming the setting.
     pub fn validate(&self) -> Result<()> {
         if self.batch == 0 {
             return config_err("batch", self.batch, "a batch needs at least one point");
@@ -177,6 +191,7 @@ pub struct StepRecord {
     pub step: usize,
     /// Mean loss over the step's batch, before the update.
     pub loss: f64,
+    /// The learning rate of the step.
     pub lr: f64,
     /// Wall time of the step (batch gather, forward, backward, reduction, Adam).
     pub seconds: f64,
@@ -187,6 +202,7 @@ pub struct StepRecord {
 pub struct TrainReport {
     /// Per step, in order.
     pub losses: Vec<f64>,
+    /// Wall seconds per step, in order.
     pub step_seconds: Vec<f64>,
     /// Including setup (workspace allocation).
     pub total_seconds: f64,

@@ -17,8 +17,11 @@ pub const SUPERSAMPLE: usize = 4;
 /// Mean, standard deviation (population) and median.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
+    /// Mean.
     pub mean: f64,
+    /// Population standard deviation.
     pub std: f64,
+    /// Median (the mean of the middle two for an even count).
     pub median: f64,
 }
 
@@ -42,7 +45,9 @@ impl Stats {
 /// One method's row.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MethodResult {
+    /// The method.
     pub method: Method,
+    /// Its name in the table ([`Method::label`]).
     pub label: String,
     /// Decoder parameters (the seed compares these).
     pub decoder_params: usize,
@@ -176,7 +181,7 @@ pub fn group(n: usize) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, ch) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i) % 3 == 0 {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(ch);
@@ -193,7 +198,7 @@ mod tests {
         let s = Stats::of(&[1.0, 3.0, 2.0, 10.0]);
         assert_eq!(s.mean, 4.0);
         assert_eq!(s.median, 2.5);
-        assert!((s.std - (((9.0 + 1.0 + 4.0 + 36.0) / 4.0) as f64).sqrt()).abs() < 1e-12);
+        assert!((s.std - ((9.0f64 + 1.0 + 4.0 + 36.0) / 4.0).sqrt()).abs() < 1e-12);
         assert_eq!(group(1234567), "1,234,567");
         assert_eq!(group(128), "128");
         assert_eq!(iou(&[true, false], &[false, false]), 0.0);

@@ -73,9 +73,9 @@ pub fn tsne_drawing(points: &[[f64; 2]], classes: &[u8], title: &str) -> Drawing
     for (p, &c) in points.iter().zip(classes) {
         d.push(Shape::Disc { center: map(*p), radius: 1.6, fill: CLASS_COLORS[c as usize % 10] });
     }
-    for c in 0..10 {
+    for (c, &fill) in CLASS_COLORS.iter().enumerate() {
         let y = 120.0 + 28.0 * c as f64;
-        d.push(Shape::Disc { center: (820.0, y), radius: 7.0, fill: CLASS_COLORS[c] });
+        d.push(Shape::Disc { center: (820.0, y), radius: 7.0, fill });
         d.push(Shape::Text {
             pos: (836.0, y),
             text: c.to_string(),
@@ -159,10 +159,15 @@ fn row_label(d: &mut Drawing, y: f64, text: String) {
 /// other decoded by the Voronoi model (top row, diagrams) and the OccNet model (bottom
 /// row, occupancy at 4× resolution), each model with its own encoder.
 pub struct Interpolation<'a> {
+    /// The row's title.
     pub title: String,
+    /// The first digit's pixels and class.
     pub a: (&'a [u8], u8),
+    /// The last digit's pixels and class.
     pub b: (&'a [u8], u8),
+    /// Rows per image.
     pub rows: usize,
+    /// Columns per image.
     pub cols: usize,
 }
 

@@ -8,7 +8,9 @@
 //! units on [code; point]) with binary cross-entropy. Every method sees the same training
 //! points. [`digit`] defines the occupancy of an image, [`idx`] reads the data as
 //! published, [`eval`] makes the seed's table, [`figures`] the tSNE and interpolation
-//! pictures.
+//! pictures. [`pipeline`] runs the experiment end to end as the `voronoi-fit mnist`
+//! commands do: training with checkpoints that resume, evaluation, tSNE, interpolation and
+//! the throughput benchmark, writing their files.
 
 pub mod digit;
 mod error;
@@ -17,6 +19,7 @@ pub mod figures;
 pub mod idx;
 pub mod model;
 pub mod net;
+pub mod pipeline;
 pub mod train;
 pub mod tsne;
 

@@ -24,7 +24,10 @@ pub enum Method {
     /// 3 hidden layers of 1,024 → 128 sites in 2D.
     Voronoi,
     /// One hidden layer of `hidden` units on [code; point] → occupancy logit.
-    OccNet { hidden: usize },
+    OccNet {
+        /// Hidden units.
+        hidden: usize,
+    },
 }
 
 impl Method {
@@ -133,10 +136,15 @@ pub fn delaunay_graph(sites: &[[f64; 2]]) -> SiteGraph {
 /// The four loss terms of one image (unweighted), and the weighted total.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LossParts {
+    /// The weighted sum of the four terms (an OccNet's: its cross-entropy).
     pub total: f64,
+    /// Reconstruction E|O − V| of the soft occupancy at the training points.
     pub reconstruction: f64,
+    /// Bounds: how far sites lie outside the unit square.
     pub bounds: f64,
+    /// Distance of each site to its side of the digit.
     pub signed_distance: f64,
+    /// Centroidal ‖L p‖² on the Delaunay graph.
     pub centroidal: f64,
 }
 

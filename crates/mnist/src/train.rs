@@ -157,7 +157,9 @@ pub struct CurvePoint {
 /// A run in progress: the model, Adam's moments, where it is, the curve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrainState {
+    /// The model being trained.
     pub model: Model,
+    /// The run's settings.
     pub settings: TrainSettings,
     m: Vec<f32>,
     v: Vec<f32>,
@@ -178,10 +180,15 @@ pub struct TrainState {
 /// Progress of a step.
 #[derive(Clone, Copy, Debug)]
 pub struct Progress {
+    /// 0-based epoch in progress.
     pub epoch: usize,
+    /// Epochs of the run.
     pub epochs: usize,
+    /// Batches of this epoch done (1-based: the step just taken).
     pub batch: usize,
+    /// Batches per epoch.
     pub batches: usize,
+    /// The step's mean loss.
     pub loss: f64,
 }
 
@@ -299,7 +306,7 @@ impl TrainState {
                     batches,
                     loss,
                 });
-                if checkpoint_every > 0 && self.step % checkpoint_every as u64 == 0 {
+                if checkpoint_every > 0 && self.step.is_multiple_of(checkpoint_every as u64) {
                     if let Some(p) = checkpoint {
                         self.seconds = base_seconds + started.elapsed().as_secs_f64();
                         self.save(p)?;

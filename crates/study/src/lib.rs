@@ -11,10 +11,13 @@
 //! of the exact signed distance on the decoders' grid. Surfaces: the Voronoi crust (exact,
 //! watertight) and marching cubes of the decoders. Distances: a certified Hausdorff
 //! interval to the analytic sphere ([`metrics::hausdorff_sphere_certified`]) and a sampled
-//! Chamfer L1 distance ([`measure`]). [`run`] returns the [`Row`]s; [`write`] writes
-//! results.csv, summary.csv, the plot, table.md and budget.json atomically.
+//! Chamfer L1 distance ([`measure`]). [`run`] returns the [`Row`]s; [`write`](mod@write) writes
+//! results.csv, summary.csv, the plot, table.md and budget.json atomically;
+//! [`run_study`] does both into an output folder from [`StudyOptions`], as
+//! `voronoi-fit study sphere` runs it.
 
 pub mod budget;
+mod command;
 pub mod data;
 pub mod measure;
 pub mod plateau;
@@ -22,6 +25,7 @@ pub mod runs;
 pub mod write;
 
 pub use budget::Budget;
+pub use command::{run_study, StudyOptions, StudyOutcome};
 pub use runs::{num_units, run, Row, StudyProgress};
 
 /// The study's sphere.
@@ -36,11 +40,22 @@ pub enum StudyError {
     /// An output could not be written.
     #[error(transparent)]
     Write(#[from] mesh_io::MeshError),
+    /// The output folder could not be created.
+    #[error("{path}: cannot create the output directory ({message})", path = path.display())]
+    CreateDir {
+        /// The output folder.
+        path: std::path::PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// The options are out of range (the message names the command-line flag).
+    #[error("{0}")]
+    Options(String),
 }
 
 impl StudyError {
-    /// The study has no input file: nothing is the input's fault.
+    /// Whether the input is at fault: the study reads no file, so only its options can be.
     pub fn is_input_fault(&self) -> bool {
-        false
+        matches!(self, StudyError::Options(_))
     }
 }

@@ -56,8 +56,12 @@ pub struct Row {
 pub trait StudyProgress {
     /// A run starts (its label, e.g. "Voronoi K = 64, seed 0").
     fn start(&mut self, _label: &str) {}
-    /// A run finished; `rows` holds every row so far (the CLI saves them as it goes).
+    /// A run finished; `rows` holds every row so far ([`crate::run_study`] saves them as
+    /// it goes).
     fn done(&mut self, _rows: &[Row]) {}
+    /// Something the user should know that does not stop the study (results.csv could not
+    /// be saved along the way).
+    fn warning(&mut self, _message: &str) {}
 }
 
 impl StudyProgress for () {}

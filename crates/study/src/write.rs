@@ -17,26 +17,37 @@ pub const TARGETS: [f64; 5] = [1e-2, 5e-3, 2e-3, 1e-3, 5e-4];
 /// One (method, size) over its seeds.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
+    /// The method ([`Row::method`]).
     pub method: String,
+    /// The size ([`Row::size`]).
     pub size: String,
+    /// Parameters.
     pub params: usize,
     /// Runs (seeds).
     pub runs: usize,
-    /// Medians over the seeds of the certified interval's ends and of the Chamfer distance.
+    /// Median over the seeds of the certified interval's lower end.
     pub hausdorff_lo_median: f64,
+    /// Median over the seeds of its upper end.
     pub hausdorff_hi_median: f64,
-    /// Spread of the upper end over the seeds.
+    /// Smallest upper end over the seeds.
     pub hausdorff_hi_min: f64,
+    /// Largest upper end over the seeds.
     pub hausdorff_hi_max: f64,
     /// Lowest lower end over the seeds (the plot's band runs from it to `hausdorff_hi_max`).
     pub hausdorff_lo_min: f64,
+    /// Median Chamfer distance over the seeds.
     pub chamfer_median: f64,
+    /// Smallest Chamfer distance.
     pub chamfer_min: f64,
+    /// Largest Chamfer distance.
     pub chamfer_max: f64,
+    /// Median training steps (rounded).
     pub steps_median: usize,
     /// How the runs ended, e.g. `3 plateau` or `2 plateau, 1 capped`.
     pub convergence: String,
+    /// Whether every run's surface is closed and manifold.
     pub all_watertight: bool,
+    /// Median training wall time.
     pub train_seconds_median: f64,
 }
 
@@ -244,6 +255,17 @@ fn fmt_need(n: Option<usize>) -> String {
 fn write_table(out: &Path, summaries: &[Summary], budget: &Budget, seconds: f64) -> Result<(), StudyError> {
     let rule = &budget.mlp_plateau;
     let mut md = String::new();
+    let selection = format!(
+        " on its cosine schedule, keeping its best iterate by a fixed evaluation batch's loss (measured every {} \
+         steps); `flattened` when the last tenth's mean loss is not below the tenth before's by more than 1% or \
+         two standard errors{}",
+        soft_voronoi::TrainConfig::default_for(8192).select_every,
+        if budget.voronoi_max_doublings == 0 {
+            String::new()
+        } else {
+            format!("; steps doubled while not flattened, up to {}×", 1usize << budget.voronoi_max_doublings)
+        }
+    );
     md += &format!(
         "Sphere of radius 0.35 in the unit cube; seeds {:?}; {} training samples per seed for every method (half \
          uniform, half near the surface). Voronoi: the main job (`fit::fit`, default settings) on an icosphere \
@@ -257,17 +279,7 @@ fn write_table(out: &Path, summaries: &[Summary], budget: &Budget, seconds: f64)
             || format!("{} (the default)", soft_voronoi::TrainConfig::default_for(8192).steps),
             |s| s.to_string(),
         ),
-        format!(
-            " on its cosine schedule, keeping its best iterate by a fixed evaluation batch's loss (measured every {} \
-             steps); `flattened` when the last tenth's mean loss is not below the tenth before's by more than 1% or \
-             two standard errors{}",
-            soft_voronoi::TrainConfig::default_for(8192).select_every,
-            if budget.voronoi_max_doublings == 0 {
-                String::new()
-            } else {
-                format!("; steps doubled while not flattened, up to {}×", 1usize << budget.voronoi_max_doublings)
-            }
-        ),
+        selection,
         budget.mlp_lr,
         budget.mlp_batch,
         rule.factor,

@@ -121,9 +121,9 @@ impl<'g, 'o> Mesher<'g, 'o> {
             return;
         }
         let (succ, joined_faces, ambiguous_faces) = face_segments(&self.v, mask, self.opts.ambiguity);
-        for e in 0..12 {
+        for (e, &next) in succ.iter().enumerate() {
             self.local_vertex[e] = u32::MAX;
-            if succ[e] != usize::MAX {
+            if next != usize::MAX {
                 self.edge_vertex(g, e);
             }
         }

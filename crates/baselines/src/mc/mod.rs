@@ -107,12 +107,15 @@ pub enum Ambiguity {
 /// Marching-cubes settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct McOptions {
+    /// The iso-level of the surface.
     pub level: f64,
     /// Position of grid point `[0, 0, 0]`.
     pub origin: [f64; 3],
     /// Distance between grid points along each axis (> 0).
     pub spacing: [f64; 3],
+    /// Which side of the level is the solid.
     pub inside: Inside,
+    /// How ambiguous faces and cells are resolved.
     pub ambiguity: Ambiguity,
 }
 
