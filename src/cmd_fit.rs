@@ -417,8 +417,15 @@ fn write_outputs(out: Outputs, result: fit::FitOutput, args: &Args, t_all: Insta
     mesh_io::write_mesh_with(&out.mesh, &result.crust, args.normals)?;
     // OUT.png: input and crust side by side from three views (the input is read again, as
     // only the result reaches this function; reading is cheap next to the fit).
-    let picture = crate::cmd_view::picture_path(&out.mesh);
-    crate::cmd_view::write_picture(&picture, &read_input(args)?, &result.crust, &args.mesh, &result.report)?;
+    let picture = viewer::picture_path(&out.mesh);
+    let figures = viewer::PictureFigures {
+        sites_trained: result.report.settings.train.num_sites,
+        sites_in_file: result.report.crust.num_sites,
+        misclassification: result.report.quality.misclassification,
+        crust_triangles: result.report.crust.num_triangles,
+    };
+    viewer::write_picture(&picture, &read_input(args)?, &result.crust, &args.mesh, &figures)
+        .map_err(crate::cmd_view::cli_error)?;
     let mut report = result.report;
     report.outputs = fit::report::OutputsReport {
         crust: out.mesh.display().to_string(),
@@ -434,7 +441,10 @@ fn write_outputs(out: Outputs, result: fit::FitOutput, args: &Args, t_all: Insta
     }
     // --html: the viewer page, from the files just written.
     let page = if args.html {
-        Some(crate::cmd_view::write_fit_page(&out.mesh, &args.mesh, &out.report, &out.sites)?)
+        Some(
+            viewer::write_fit_page(&out.mesh, &args.mesh, &out.report, &out.sites)
+                .map_err(crate::cmd_view::cli_error)?,
+        )
     } else {
         None
     };

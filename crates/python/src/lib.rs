@@ -1,6 +1,6 @@
 //! `voronoi_fit._native`: the Python package's native half. Every function calls the same
 //! library code as the CLI (`fit::fit` through `fit::FitOptions`, `occupancy::MeshOracle`,
-//! `delaunay3`, `crust`, `metrics`) and releases the GIL while it works.
+//! `delaunay3`, `crust`, `metrics`, `viewer`) and releases the GIL while it works.
 //!
 //! Arrays cross the boundary as little-endian bytes (`float64`, `uint32`, `uint8`), which
 //! the pure-Python half (`python/voronoi_fit/__init__.py`) makes from and turns back into
@@ -39,7 +39,7 @@ fn failure(m: impl std::fmt::Display) -> PyErr {
 
 /// n×3 float64 rows from little-endian bytes.
 fn rows_f64(bytes: &[u8], what: &str) -> PyResult<Vec<[f64; 3]>> {
-    if bytes.len() % 24 != 0 {
+    if !bytes.len().is_multiple_of(24) {
         return Err(input_error(format!(
             "{what}: {} bytes is not a whole number of (x, y, z) float64 rows",
             bytes.len()
@@ -57,7 +57,7 @@ fn rows_f64(bytes: &[u8], what: &str) -> PyResult<Vec<[f64; 3]>> {
 
 /// n×3 uint32 rows from little-endian bytes.
 fn rows_u32(bytes: &[u8], what: &str) -> PyResult<Vec<[u32; 3]>> {
-    if bytes.len() % 12 != 0 {
+    if !bytes.len().is_multiple_of(12) {
         return Err(input_error(format!("{what}: {} bytes is not a whole number of uint32 triples", bytes.len())));
     }
     Ok(bytes
@@ -177,7 +177,7 @@ fn fit_mesh<'py>(
     let input = mesh(vertices, faces, name)?;
     let options: FitOptions =
         serde_json::from_str(options_json).map_err(|e| input_error(format!("fit options: {e}")))?;
-    let mut config = options.to_config(name).map_err(|e| input_error(e))?;
+    let mut config = options.to_config(name).map_err(input_error)?;
     // float64 unless asked: the CLI rounds (and checks again) at float32 only for glTF, and
     // so does `float32` here, for a crust that will be saved as GLB.
     config.output_precision = if float32 { ::crust::output::Precision::F32 } else { ::crust::output::Precision::F64 };
@@ -352,6 +352,42 @@ fn evaluate(py: Python<'_>, vr: &[u8], fr: &[u8], vp: &[u8], fp: &[u8]) -> PyRes
     serde_json::to_string(&report).map_err(failure)
 }
 
+/// The viewer page of a crust (`viewer::write_page`, as `voronoi-fit view`): paths of the
+/// crust and, optionally, the input, report, sites file, cells and page; the fresh samples
+/// checked for misclassified points. Returns (the page's path, notes on what it left out).
+#[pyfunction]
+#[pyo3(signature = (crust, input=None, report=None, sites=None, cells=None, out=None, check_samples=::viewer::DEFAULT_CHECK_SAMPLES))]
+#[allow(clippy::too_many_arguments)]
+fn view(
+    py: Python<'_>,
+    crust: &str,
+    input: Option<&str>,
+    report: Option<&str>,
+    sites: Option<&str>,
+    cells: Option<&str>,
+    out: Option<&str>,
+    check_samples: usize,
+) -> PyResult<(String, Vec<String>)> {
+    let path = |p: Option<&str>| p.map(std::path::PathBuf::from);
+    let options = ::viewer::PageOptions {
+        crust: crust.into(),
+        input: path(input),
+        report: path(report),
+        sites: path(sites),
+        cells: path(cells),
+        output: path(out),
+        check_samples,
+    };
+    let page = py.allow_threads(|| ::viewer::write_page(&options)).map_err(|e| {
+        if e.is_input_fault() {
+            input_error(e)
+        } else {
+            failure(e)
+        }
+    })?;
+    Ok((page.path.display().to_string(), page.notes))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", m.py().get_type::<InputError>())?;
@@ -366,5 +402,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(save_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(save_sites, m)?)?;
+    m.add_function(wrap_pyfunction!(view, m)?)?;
     Ok(())
 }
