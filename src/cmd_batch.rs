@@ -61,7 +61,8 @@ pub struct Args {
     pub fit_args: Vec<String>,
 }
 
-/// One mesh's `voronoi-fit fit` command line, parsed by the fit command's own arguments.
+/// The fit options after `--` as a `voronoi-fit fit` command line, parsed once by the fit
+/// command's own arguments.
 #[derive(Parser)]
 #[command(name = "voronoi-fit")]
 struct FitLine {

@@ -265,6 +265,12 @@ pub fn read_provenance(dir: &Path) -> Option<Provenance> {
     serde_json::from_str(&std::fs::read_to_string(dir.join("batch.json")).ok()?).ok()
 }
 
+/// Whether `dir` holds the finished result of `name` made from `prov` (its `batch.json`
+/// matches and its report is there): a rerun skips it.
+pub fn is_finished(dir: &Path, name: &str, prov: &Provenance) -> bool {
+    read_provenance(dir).as_ref() == Some(prov) && dir.join(format!("{name}.voronoi.report.json")).is_file()
+}
+
 /// Stops training when the flag is set.
 struct Flag<'a>(&'a AtomicBool);
 
@@ -272,6 +278,45 @@ impl fit::Progress for Flag<'_> {
     fn should_stop(&mut self) -> bool {
         self.0.load(Ordering::SeqCst)
     }
+}
+
+/// Fits `job` into the work folder `work` (created if needed): `batch.json` first, then
+/// the main job's files named `NAME.voronoi.FORMAT` and so on, continuing from the
+/// folder's checkpoint when `resume`. A panic in the fit is caught and returned as an
+/// error; [`Error::Interrupted`] when `interrupted` stopped it (the checkpoint stays).
+pub fn fit_into(
+    job: &Job,
+    options: &BatchOptions,
+    prov: &Provenance,
+    work: &Path,
+    resume: bool,
+    interrupted: &AtomicBool,
+) -> Result<(), Error> {
+    std::fs::create_dir_all(work).map_err(|e| Error::Failure(format!("{}: cannot create ({e})", work.display())))?;
+    let text = serde_json::to_string_pretty(prov).map_err(|e| Error::Failure(format!("batch.json: {e}")))?;
+    mesh_io::atomic_write(&work.join("batch.json"), |w| w.write_all(text.as_bytes()))?;
+    let fit_job = FitJob {
+        mesh: job.input.clone(),
+        output: Some(work.join(format!("{}.voronoi.{}", job.name, options.format))),
+        resume: resume.then(|| checkpoint_in(work, &job.name)),
+        ..options.fit.clone()
+    };
+    // A panic is a bug, but one mesh's bug must not end the batch.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| fit_to_files(&fit_job, &mut Flag(interrupted))))
+        .map_err(|p| {
+            let what = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown".into());
+            Error::Failure(format!("internal error (panic: {what}); please report it with this mesh"))
+        })??;
+    Ok(())
+}
+
+/// The checkpoint of `name`'s fit in the work folder `work`.
+pub fn checkpoint_in(work: &Path, name: &str) -> PathBuf {
+    work.join(format!("{name}.voronoi.ckpt.npz"))
 }
 
 /// One mesh: skip, resume or fit in `OUT/.work/NAME/`, then publish the folder as
@@ -289,41 +334,18 @@ pub fn run_one(job: &Job, options: &BatchOptions, interrupted: &AtomicBool) -> R
         Err(e) => return Ok(failed(e, &t)),
     };
     let done_dir = options.out.join(&job.name);
-    let crust_name = format!("{}.voronoi.{}", job.name, options.format);
-    if read_provenance(&done_dir).as_ref() == Some(&prov)
-        && done_dir.join(format!("{}.voronoi.report.json", job.name)).is_file()
-    {
+    if is_finished(&done_dir, &job.name, &prov) {
         return Ok(Outcome::Done { seconds: 0.0, reused: true, resumed: false });
     }
-    let work = options.out.join(".work").join(&job.name);
-    let checkpoint = work.join(format!("{}.voronoi.ckpt.npz", job.name));
+    let scratch = options.out.join(".work");
+    let work = scratch.join(&job.name);
+    let checkpoint = checkpoint_in(&work, &job.name);
     let resume = read_provenance(&work).as_ref() == Some(&prov) && checkpoint.is_file();
     if !resume {
         let _ = std::fs::remove_dir_all(&work);
     }
-    let result = (|| -> Result<(), Error> {
-        std::fs::create_dir_all(&work)
-            .map_err(|e| Error::Failure(format!("{}: cannot create ({e})", work.display())))?;
-        let text = serde_json::to_string_pretty(&prov).map_err(|e| Error::Failure(format!("batch.json: {e}")))?;
-        mesh_io::atomic_write(&work.join("batch.json"), |w| w.write_all(text.as_bytes()))?;
-        let fit_job = FitJob {
-            mesh: job.input.clone(),
-            output: Some(work.join(&crust_name)),
-            resume: resume.then(|| checkpoint.clone()),
-            ..options.fit.clone()
-        };
-        // A panic is a bug, but one mesh's bug must not end the batch.
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| fit_to_files(&fit_job, &mut Flag(interrupted))))
-            .map_err(|p| {
-                let what = p
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| p.downcast_ref::<String>().cloned())
-                    .unwrap_or_else(|| "unknown".into());
-                Error::Failure(format!("internal error (panic: {what}); please report it with this mesh"))
-            })??;
-        publish(&work, &done_dir, &options.out.join(".work"), &job.name)
-    })();
+    let result = fit_into(job, options, &prov, &work, resume, interrupted)
+        .and_then(|()| publish(&work, &done_dir, &scratch.join(format!("{}.replaced", job.name)), &prov).map(|_| ()));
     match result {
         Ok(()) => Ok(Outcome::Done { seconds: t.elapsed().as_secs_f64(), reused: false, resumed: resume }),
         Err(Error::Interrupted { .. }) => Err(Stopped),
@@ -337,19 +359,38 @@ pub fn run_one(job: &Job, options: &BatchOptions, interrupted: &AtomicBool) -> R
     }
 }
 
-/// Moves the finished work folder `work` to `done`; an older result is moved aside (into
-/// `scratch`) first and removed after.
-pub fn publish(work: &Path, done: &Path, scratch: &Path, name: &str) -> Result<(), Error> {
+/// How [`publish`] ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Published {
+    /// The work folder is now the result.
+    Moved,
+    /// Another attempt had already published the same result (same provenance): the work
+    /// folder was removed and the result left as it was.
+    AlreadyThere,
+}
+
+/// Publishes the finished work folder `work` as `done` by one rename. When `done` is in
+/// the way: a finished result of the same provenance `prov` (another attempt of the same
+/// mesh published first) stays and `work` is removed; anything else is moved to `aside`
+/// first and removed after.
+pub fn publish(work: &Path, done: &Path, aside: &Path, prov: &Provenance) -> Result<Published, Error> {
     let fail =
         |e: std::io::Error| Error::Failure(format!("{}: cannot move the result into place ({e})", done.display()));
-    let old = scratch.join(format!("{name}.replaced"));
+    if std::fs::rename(work, done).is_ok() {
+        return Ok(Published::Moved);
+    }
+    let name = done.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    if is_finished(done, &name, prov) {
+        let _ = std::fs::remove_dir_all(work);
+        return Ok(Published::AlreadyThere);
+    }
     if done.exists() {
-        let _ = std::fs::remove_dir_all(&old);
-        std::fs::rename(done, &old).map_err(fail)?;
+        let _ = std::fs::remove_dir_all(aside);
+        std::fs::rename(done, aside).map_err(fail)?;
     }
     std::fs::rename(work, done).map_err(fail)?;
-    let _ = std::fs::remove_dir_all(&old);
-    Ok(())
+    let _ = std::fs::remove_dir_all(aside);
+    Ok(Published::Moved)
 }
 
 /// Runs the plan: creates the output folder, fits `options.jobs` meshes at once (each on
@@ -426,14 +467,27 @@ pub const SUMMARY_HEADER: &str =
     "name,input,status,error,seconds,hausdorff_hi,hausdorff_of_diagonal,chamfer_l1,fscore,\
 normal_consistency,iou,misclassification,sites,triangles,components,genus,folder";
 
-/// `summary.csv` in `out`, atomically: one row per job in plan order; figures from each
-/// finished folder's report.
-pub fn write_summary(out: &Path, jobs: &[Job], outcomes: &[Option<Outcome>]) -> Result<(), Error> {
-    let mut text = format!("{SUMMARY_HEADER}\n");
-    let csv =
-        |s: &str| if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() };
-    for (job, outcome) in jobs.iter().zip(outcomes) {
-        let dir = out.join(&job.name);
+/// One row of `summary.csv` before the report's figures are added.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SummaryRow {
+    /// The mesh and its folder name.
+    pub job: Job,
+    /// `fitted`, `done earlier`, `bad input`, `failed`, `not run`, …
+    pub status: String,
+    /// The error, if any.
+    pub error: String,
+    /// Seconds spent on it in this run (empty: the report's `total_seconds` for a
+    /// finished result).
+    pub seconds: String,
+    /// Whether `OUT/NAME/` holds its result (its report's figures are filled in).
+    pub finished: bool,
+    /// Values of the runner's extra columns, in order.
+    pub extra: Vec<String>,
+}
+
+impl SummaryRow {
+    /// The row of `job` with this outcome.
+    pub fn of(job: &Job, outcome: Option<&Outcome>) -> Self {
         let (status, error, seconds) = match outcome {
             None => ("not run", String::new(), String::new()),
             Some(Outcome::Done { reused: true, .. }) => ("done earlier", String::new(), String::new()),
@@ -444,7 +498,39 @@ pub fn write_summary(out: &Path, jobs: &[Job], outcomes: &[Option<Outcome>]) -> 
                 (if *input_fault { "bad input" } else { "failed" }, error.clone(), format!("{seconds:.1}"))
             }
         };
-        let ok = matches!(outcome, Some(Outcome::Done { .. }));
+        SummaryRow {
+            job: job.clone(),
+            status: status.into(),
+            error,
+            seconds,
+            finished: matches!(outcome, Some(Outcome::Done { .. })),
+            extra: Vec::new(),
+        }
+    }
+}
+
+/// `summary.csv` in `out`, atomically: one row per job in plan order; figures from each
+/// finished folder's report.
+pub fn write_summary(out: &Path, jobs: &[Job], outcomes: &[Option<Outcome>]) -> Result<(), Error> {
+    let rows: Vec<SummaryRow> = jobs.iter().zip(outcomes).map(|(j, o)| SummaryRow::of(j, o.as_ref())).collect();
+    write_summary_rows(out, &rows, &[])
+}
+
+/// `summary.csv` in `out`, atomically, from rows: [`SUMMARY_HEADER`]'s columns (figures
+/// from each finished folder's report), then `extra_columns` (a runner's own, e.g. the
+/// Ray runner's worker and node).
+pub fn write_summary_rows(out: &Path, rows: &[SummaryRow], extra_columns: &[String]) -> Result<(), Error> {
+    let csv =
+        |s: &str| if s.contains([',', '"', '\n']) { format!("\"{}\"", s.replace('"', "\"\"")) } else { s.to_string() };
+    let mut text = String::from(SUMMARY_HEADER);
+    for c in extra_columns {
+        text.push(',');
+        text.push_str(&csv(c));
+    }
+    text.push('\n');
+    for r in rows {
+        let (job, ok) = (&r.job, r.finished);
+        let dir = out.join(&job.name);
         let report: Option<serde_json::Value> = ok
             .then(|| std::fs::read_to_string(dir.join(format!("{}.voronoi.report.json", job.name))).ok())
             .flatten()
@@ -461,7 +547,7 @@ pub fn write_summary(out: &Path, jobs: &[Job], outcomes: &[Option<Outcome>]) -> 
                 _ => String::new(),
             }
         };
-        let seconds = if seconds.is_empty() && ok { get(&["total_seconds"]) } else { seconds };
+        let seconds = if r.seconds.is_empty() && ok { get(&["total_seconds"]) } else { r.seconds.clone() };
         let h_of_d = {
             let (h, d) = (
                 get(&["metrics", "hausdorff", "hi"]).parse::<f64>(),
@@ -472,11 +558,11 @@ pub fn write_summary(out: &Path, jobs: &[Job], outcomes: &[Option<Outcome>]) -> 
                 _ => String::new(),
             }
         };
-        let row = [
+        let mut row = vec![
             csv(&job.name),
             csv(&job.input.display().to_string()),
-            status.to_string(),
-            csv(&error),
+            csv(&r.status),
+            csv(&r.error),
             seconds,
             get(&["metrics", "hausdorff", "hi"]),
             h_of_d,
@@ -491,6 +577,7 @@ pub fn write_summary(out: &Path, jobs: &[Job], outcomes: &[Option<Outcome>]) -> 
             get(&["crust", "genus"]),
             if ok { csv(&dir.display().to_string()) } else { String::new() },
         ];
+        row.extend((0..extra_columns.len()).map(|k| csv(r.extra.get(k).map_or("", String::as_str))));
         text.push_str(&row.join(","));
         text.push('\n');
     }
@@ -541,5 +628,52 @@ mod tests {
         assert_eq!(lines[0], SUMMARY_HEADER);
         assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(12)));
         assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(14)));
+        // A runner's own columns go last.
+        let mut row = SummaryRow::of(&jobs[1], None);
+        row.extra = vec!["12".into()];
+        write_summary_rows(dir.path(), &[row], &["attempt_pid".into(), "node".into()]).unwrap();
+        let text = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
+        assert_eq!(text.lines().next(), Some(format!("{SUMMARY_HEADER},attempt_pid,node").as_str()));
+        assert!(text.lines().nth(1).unwrap().ends_with(",12,"), "{text}");
+    }
+
+    /// Publishing: a free place takes the work folder; the same finished result stays (the
+    /// work folder goes); another result is replaced, and nothing is left aside.
+    #[test]
+    fn publish_moves_keeps_or_replaces() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("m.obj");
+        std::fs::write(&input, "v 0 0 0\n").unwrap();
+        let job = Job { input, name: "m".into() };
+        let options = BatchOptions {
+            out: dir.path().join("out"),
+            jobs: 1,
+            format: "glb".into(),
+            fit: FitJob::default(),
+            fit_args: vec!["--sites".into(), "8".into()],
+            version: "test".into(),
+        };
+        let prov = provenance(&job, &options).unwrap();
+        assert_eq!(prov.input_bytes, 8);
+        let (done, aside) = (options.out.join("m"), options.out.join(".work/m.replaced"));
+        let attempt = |tag: &str, p: &Provenance| {
+            let work = options.out.join(".work").join(format!("m.{tag}"));
+            std::fs::create_dir_all(&work).unwrap();
+            std::fs::write(work.join("batch.json"), serde_json::to_string(p).unwrap()).unwrap();
+            std::fs::write(work.join("m.voronoi.report.json"), tag).unwrap();
+            work
+        };
+        let first = attempt("a", &prov);
+        assert_eq!(publish(&first, &done, &aside, &prov).unwrap(), Published::Moved);
+        assert!(is_finished(&done, "m", &prov) && !first.exists());
+        let second = attempt("b", &prov);
+        assert_eq!(publish(&second, &done, &aside, &prov).unwrap(), Published::AlreadyThere);
+        assert_eq!(std::fs::read_to_string(done.join("m.voronoi.report.json")).unwrap(), "a");
+        assert!(!second.exists());
+        let other = Provenance { fit_args: vec![], ..prov.clone() };
+        let third = attempt("c", &other);
+        assert_eq!(publish(&third, &done, &aside, &other).unwrap(), Published::Moved);
+        assert_eq!(std::fs::read_to_string(done.join("m.voronoi.report.json")).unwrap(), "c");
+        assert!(!third.exists() && !aside.exists() && !is_finished(&done, "m", &prov));
     }
 }

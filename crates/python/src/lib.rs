@@ -1,6 +1,7 @@
 //! `voronoi_fit._native`: the Python package's native half. Every function calls the same
 //! library code as the CLI (`fit::fit` through `fit::FitOptions`, `occupancy::MeshOracle`,
-//! `delaunay3`, `crust`, `metrics`, `viewer`) and releases the GIL while it works.
+//! `delaunay3`, `crust`, `metrics`, `viewer`, and `jobs`' batch protocol for the Ray runner)
+//! and releases the GIL while it works.
 //!
 //! Arrays cross the boundary as little-endian bytes (`float64`, `uint32`, `uint8`), which
 //! the pure-Python half (`python/voronoi_fit/__init__.py`) makes from and turns back into
@@ -11,6 +12,8 @@
 //! message; `Error` (a `RuntimeError`) otherwise; an exception raised by the progress
 //! callback, or Ctrl-C (`KeyboardInterrupt`), stops the fit at the next step and is
 //! raised as it is.
+
+mod batch;
 
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -29,11 +32,11 @@ create_exception!(
 );
 create_exception!(_native, Error, PyRuntimeError, "A failure that is not the input's fault.");
 
-fn input_error(m: impl std::fmt::Display) -> PyErr {
+pub(crate) fn input_error(m: impl std::fmt::Display) -> PyErr {
     InputError::new_err(m.to_string())
 }
 
-fn failure(m: impl std::fmt::Display) -> PyErr {
+pub(crate) fn failure(m: impl std::fmt::Display) -> PyErr {
     Error::new_err(m.to_string())
 }
 
@@ -403,5 +406,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(save_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(save_sites, m)?)?;
     m.add_function(wrap_pyfunction!(view, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_finished, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_fit_into, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_publish, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_write_summary, m)?)?;
     Ok(())
 }
