@@ -50,7 +50,7 @@ impl Args {
 }
 
 /// A viewer error as the binary's: the input's fault exits 2, anything else 1.
-pub fn cli_error(e: viewer::Error) -> CliError {
+fn cli_error(e: viewer::Error) -> CliError {
     if e.is_input_fault() {
         CliError::BadInput(e.into())
     } else {
