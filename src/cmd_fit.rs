@@ -1,18 +1,14 @@
 //! The main job, `voronoi-fit MESH [-o OUT.glb] [--sites K] [--steps S] [--seed N]`: the
-//! arguments, the output paths, Ctrl-C and the progress bar around [`fit::fit`], which
-//! does the work.
-//!
-//! Writes OUT.glb (the crust), OUT.sites.npz (the sites file), OUT.report.json, and, while
+//! arguments, Ctrl-C, the progress bar and the printing around [`jobs::fit_to_files`],
+//! which writes OUT.glb (the crust), OUT.sites.npz, OUT.png, OUT.report.json and, while
 //! training, OUT.ckpt.npz (every `--checkpoint-every` steps and on Ctrl-C; removed when the
 //! run finishes unless `--keep-checkpoint`).
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Instant;
 
-use fit::{Checkpointing, FitConfig, FitError, FitOptions, Progress, SolidRule};
-use mesh_io::OutputFormat;
+use fit::{FitOptions, Progress, SolidRule};
 use soft_voronoi::{Init, StepStats};
 
 use crate::cli_error::CliError;
@@ -193,78 +189,75 @@ fn parse_solid(s: &str) -> Result<SolidRule, String> {
     }
 }
 
-/// Paths of the outputs.
-struct Outputs {
-    mesh: PathBuf,
-    sites: PathBuf,
-    report: PathBuf,
-    checkpoint: PathBuf,
-}
-
-/// The output paths, checked before any work: a known mesh format, a writable folder.
-fn outputs(args: &Args) -> Result<Outputs, CliError> {
-    let mesh = match &args.output {
-        Some(p) => p.clone(),
-        None => {
-            let stem = args.mesh.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_else(|| "mesh".into());
-            PathBuf::from(format!("{stem}.voronoi.glb"))
+impl Args {
+    /// The typed options of the main job for these arguments (the fit options through
+    /// [`fit::FitOptions`], as the Python package passes them).
+    pub fn to_job(&self) -> jobs::FitJob {
+        jobs::FitJob {
+            mesh: self.mesh.clone(),
+            output: self.output.clone(),
+            normals: self.normals,
+            options: FitOptions {
+                sites: self.sites,
+                steps: self.steps,
+                seed: self.seed,
+                preset: Some(self.preset.clone()),
+                init: self.init,
+                batch: self.batch,
+                lr: self.lr,
+                beta_start: self.beta_start,
+                surface_offset: self.surface_offset,
+                w_sdf: self.w_sdf,
+                w_centroidal: self.w_centroidal,
+                w_normal: self.w_normal,
+                w_reconstruction: self.w_reconstruction,
+                w_surface: self.w_surface,
+                samples: Some(self.samples),
+                eval_samples: Some(self.eval_samples),
+                solid: self.solid,
+                shell_thickness: self.shell_thickness,
+                no_relabel: self.no_relabel,
+                carve: self.carve,
+                no_carve: self.no_carve,
+                no_prune: self.no_prune,
+                skip_metrics: false,
+                no_polish: self.no_polish,
+                polish_steps: self.polish_steps,
+                polish_lr: self.polish_lr,
+                polish_align: self.polish_align,
+            },
+            weld_tolerance: self.weld_tolerance,
+            target_hausdorff: self.target_hausdorff,
+            max_sites: self.max_sites,
+            checkpoint_every: self.checkpoint_every,
+            resume: self.resume.clone(),
+            stop_after: self.stop_after,
+            keep_checkpoint: self.keep_checkpoint,
+            html: self.html,
         }
-    };
-    // Before any work: an unknown format exits 2, an unwritable folder 1 (as `convert`).
-    OutputFormat::from_path(&mesh)?;
-    mesh_io::check_output_location(&mesh)?;
-    let base = mesh.with_extension("");
-    let with = |suffix: &str| PathBuf::from(format!("{}{suffix}", base.display()));
-    Ok(Outputs { sites: with(".sites.npz"), report: with(".report.json"), checkpoint: with(".ckpt.npz"), mesh })
-}
-
-/// Raw flags → the validated fit settings (through [`fit::FitOptions`], as the Python
-/// package does).
-fn config_from_args(args: &Args, out: &Outputs) -> Result<FitConfig, CliError> {
-    let options = FitOptions {
-        sites: args.sites,
-        steps: args.steps,
-        seed: args.seed,
-        preset: Some(args.preset.clone()),
-        init: args.init,
-        batch: args.batch,
-        lr: args.lr,
-        beta_start: args.beta_start,
-        surface_offset: args.surface_offset,
-        w_sdf: args.w_sdf,
-        w_centroidal: args.w_centroidal,
-        w_normal: args.w_normal,
-        w_reconstruction: args.w_reconstruction,
-        w_surface: args.w_surface,
-        samples: Some(args.samples),
-        eval_samples: Some(args.eval_samples),
-        solid: args.solid,
-        shell_thickness: args.shell_thickness,
-        no_relabel: args.no_relabel,
-        carve: args.carve,
-        no_carve: args.no_carve,
-        no_prune: args.no_prune,
-        skip_metrics: false,
-        no_polish: args.no_polish,
-        polish_steps: args.polish_steps,
-        polish_lr: args.polish_lr,
-        polish_align: args.polish_align,
-    };
-    let mut c = options.to_config(&args.mesh.display().to_string())?;
-    c.checkpointing = Some(Checkpointing { path: out.checkpoint.clone(), every: args.checkpoint_every });
-    c.output_precision = crust::output::Precision::of_path(&out.mesh)?;
-    if let Some(p) = &args.resume {
-        return Ok(c.resume(p)?);
     }
-    Ok(c)
 }
 
-/// The progress bar, Ctrl-C and `--stop-after`.
+/// A job error as the binary's: a stopped run exits 130 with how to continue, the input's
+/// fault 2, anything else 1.
+pub fn cli_error(e: jobs::Error) -> CliError {
+    match e {
+        jobs::Error::Interrupted { step, steps, checkpoint, mesh, output } => CliError::Interrupted(format!(
+            "stopped at step {step} of {steps}; checkpoint {}. Continue with: voronoi-fit {} -o {} --resume {}",
+            checkpoint.display(),
+            mesh.display(),
+            output.display(),
+            checkpoint.display()
+        )),
+        e if e.is_input_fault() => CliError::BadInput(e.into()),
+        e => CliError::Failure(e.into()),
+    }
+}
+
+/// The progress bar and Ctrl-C.
 struct CliProgress {
     bar: indicatif::ProgressBar,
     interrupted: Arc<AtomicBool>,
-    stop_after: Option<usize>,
-    done_here: usize,
 }
 
 impl Progress for CliProgress {
@@ -276,15 +269,14 @@ impl Progress for CliProgress {
     }
 
     fn train_step(&mut self, s: &StepStats) {
-        self.done_here += 1;
         self.bar.set_position(s.step as u64 + 1);
-        if s.step % 10 == 0 {
+        if s.step.is_multiple_of(10) {
             self.bar.set_message(format!("loss {:.5} (recon {:.5})", s.total, s.reconstruction));
         }
     }
 
     fn should_stop(&mut self) -> bool {
-        self.interrupted.load(Ordering::SeqCst) || self.stop_after.is_some_and(|n| self.done_here >= n)
+        self.interrupted.load(Ordering::SeqCst)
     }
 
     fn train_end(&mut self) {
@@ -298,21 +290,13 @@ impl Progress for CliProgress {
             self.bar.set_prefix("polish");
         }
         self.bar.set_position(done as u64);
-        if done % 10 == 0 {
+        if done.is_multiple_of(10) {
             self.bar.set_message(format!("VoroLoss {loss:.3e}"));
         }
         if done == total {
             self.bar.finish_and_clear();
         }
     }
-}
-
-fn read_input(args: &Args) -> Result<mesh_io::TriMesh, CliError> {
-    let mesh = mesh_io::read_mesh(&args.mesh)?;
-    Ok(match args.weld_tolerance {
-        Some(t) => mesh_io::weld::weld_tolerance(&mesh, t).0,
-        None => mesh,
-    })
 }
 
 pub fn run(args: Args) -> Result<(), CliError> {
@@ -324,13 +308,18 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     }
     let bar = if args.quiet || args.json { indicatif::ProgressBar::hidden() } else { indicatif::ProgressBar::new(0) };
-    let done = fit_to_files(&args, interrupted, bar)?;
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{prefix} {bar:30} {pos}/{len} steps, {msg}, {elapsed} (ETA {eta})")
+            .map_err(anyhow::Error::from)?,
+    );
+    let mut progress = CliProgress { bar, interrupted };
+    let done = jobs::fit_to_files(&args.to_job(), &mut progress).map_err(cli_error)?;
     if args.json {
         crate::output::out!("{}", done.json);
     } else {
         // How viewers will shade a glTF crust (README, *Looking at the result*).
         let gltf = matches!(
-            mesh_io::OutputFormat::from_path(&done.out.mesh),
+            mesh_io::OutputFormat::from_path(&done.outputs.mesh),
             Ok(mesh_io::OutputFormat::Glb | mesh_io::OutputFormat::Gltf)
         );
         let shading = match args.normals {
@@ -342,10 +331,10 @@ pub fn run(args: Args) -> Result<(), CliError> {
         crate::output::out!(
             "{} Wrote {}{shading}, {}, {} and {} in {:.1} s.",
             done.report.summary(),
-            done.out.mesh.display(),
-            done.out.sites.display(),
+            done.outputs.mesh.display(),
+            done.outputs.sites.display(),
             done.picture.display(),
-            done.out.report.display(),
+            done.outputs.report.display(),
             done.report.total_seconds
         );
         if let Some(page) = &done.page {
@@ -353,90 +342,4 @@ pub fn run(args: Args) -> Result<(), CliError> {
         }
     }
     Ok(())
-}
-
-/// What [`fit_to_files`] wrote.
-pub struct Written {
-    out: Outputs,
-    /// The report as written.
-    pub report: fit::FitReport,
-    /// The report's JSON text.
-    pub json: String,
-    picture: PathBuf,
-    page: Option<PathBuf>,
-}
-
-/// The main job for one mesh, from parsed arguments to the files on disk (crust, sites,
-/// picture, report, optional page), printing nothing: `voronoi-fit MESH` and each mesh of
-/// `voronoi-fit batch`. Training stops with a checkpoint when `interrupted` is set;
-/// `bar` shows the training steps (hidden for no bar).
-pub fn fit_to_files(
-    args: &Args,
-    interrupted: Arc<AtomicBool>,
-    bar: indicatif::ProgressBar,
-) -> Result<Written, CliError> {
-    let t_all = Instant::now();
-    let out = outputs(args)?;
-    let config = config_from_args(args, &out)?;
-    let input = read_input(args)?;
-    if OutputFormat::from_path(&out.mesh)?.stores_f32() {
-        // The crust is written in the input's frame; refuse now if float32 cannot resolve it.
-        mesh_io::check_f32_resolution(&input, &args.mesh)?;
-    }
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{prefix} {bar:30} {pos}/{len} steps, {msg}, {elapsed} (ETA {eta})")
-            .map_err(anyhow::Error::from)?,
-    );
-    let mut progress = CliProgress { bar, interrupted, stop_after: args.stop_after, done_here: 0 };
-    let result = match args.target_hausdorff {
-        Some(h) => {
-            let goal = fit::AccuracyGoal { hausdorff_of_diagonal: h, max_sites: args.max_sites };
-            fit::fit_to_accuracy(&input, &config, &goal, &mut progress)
-        }
-        None => fit::fit(&input, &config, &mut progress),
-    };
-    let result = match result {
-        Err(FitError::Interrupted { step, steps, checkpoint }) => {
-            return Err(CliError::Interrupted(format!(
-                "stopped at step {step} of {steps}; checkpoint {}. Continue with: voronoi-fit {} -o {} --resume {}",
-                checkpoint.display(),
-                args.mesh.display(),
-                out.mesh.display(),
-                checkpoint.display()
-            )))
-        }
-        r => r?,
-    };
-    write_outputs(out, result, args, t_all)
-}
-
-/// Sites file, crust and report, each atomically (the report last: its presence means the
-/// run finished), and the optional page.
-fn write_outputs(out: Outputs, result: fit::FitOutput, args: &Args, t_all: Instant) -> Result<Written, CliError> {
-    result.sites.write(&out.sites)?;
-    mesh_io::write_mesh_with(&out.mesh, &result.crust, args.normals)?;
-    // OUT.png: input and crust side by side from three views (the input is read again, as
-    // only the result reaches this function; reading is cheap next to the fit).
-    let picture = crate::cmd_view::picture_path(&out.mesh);
-    crate::cmd_view::write_picture(&picture, &read_input(args)?, &result.crust, &args.mesh, &result.report)?;
-    let mut report = result.report;
-    report.outputs = fit::report::OutputsReport {
-        crust: out.mesh.display().to_string(),
-        sites: out.sites.display().to_string(),
-        report: out.report.display().to_string(),
-        crust_normals: args.normals.to_string(),
-    };
-    report.total_seconds = t_all.elapsed().as_secs_f64();
-    let json = serde_json::to_string_pretty(&report).map_err(anyhow::Error::from)?;
-    mesh_io::atomic_write(&out.report, |w| w.write_all(json.as_bytes()))?;
-    if !args.keep_checkpoint && out.checkpoint.exists() {
-        let _ = std::fs::remove_file(&out.checkpoint);
-    }
-    // --html: the viewer page, from the files just written.
-    let page = if args.html {
-        Some(crate::cmd_view::write_fit_page(&out.mesh, &args.mesh, &out.report, &out.sites)?)
-    } else {
-        None
-    };
-    Ok(Written { out, report, json, picture, page })
 }

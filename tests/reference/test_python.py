@@ -282,3 +282,58 @@ def test_saved_files_are_the_cli_files_and_the_glb_is_valid(bunny, tmp_path):
     with pytest.raises(vf.InputError, match="float32=True"):
         vf.fit(BUNNY, progress=False, float32=False, **SMALL).save(tmp_path / "f64")
     assert not list(tmp_path.glob("f64*")), "nothing written when refused"
+
+
+def test_cluster_tasks_follow_the_batch_protocol(tmp_path):
+    """The Ray runner's task (`voronoi_fit.cluster.fit_one`, here without Ray) runs the
+    Rust batch protocol: `voronoi-fit batch`'s folder names (shared stems get the path
+    hash), files, `batch.json` fields and summary columns, the same crust bytes; a second
+    attempt finds the result and publishes nothing; bad input is a row, not an exception."""
+    import csv
+    import shutil
+
+    from voronoi_fit import cluster
+
+    meshes = tmp_path / "meshes"
+    (meshes / "a").mkdir(parents=True)
+    (meshes / "b").mkdir()
+    shutil.copy(ROOT / "assets" / "torus.obj", meshes / "a" / "torus.obj")
+    shutil.copy(ROOT / "assets" / "torus.obj", meshes / "b" / "torus.obj")
+    shutil.copy(ROOT / "tests" / "malformed" / "nan_vertex.obj", meshes / "nan_vertex.obj")
+    manifest = tmp_path / "manifest.txt"
+    manifest.write_text("# two meshes with one stem, and a broken one\nmeshes/a/torus.obj\nmeshes/b/torus.obj\n"
+                        "meshes/a/torus.obj\nmeshes/nan_vertex.obj\n")
+    jobs = cluster.plan(manifest)
+    names = [n for _, n in jobs]
+    assert len(names) == 3 and names[0].startswith("torus-") and names[1].startswith("torus-")
+    assert names[0] != names[1] and names[2] == "nan_vertex"
+
+    opts = ["--sites", "256", "--steps", "20", "--samples", "20000", "--eval-samples", "2000", "--polish-steps", "50"]
+    options = dict(sites=256, steps=20, samples=20000, eval_samples=2000, polish_steps=50, seed=0)
+    out = tmp_path / "out"
+    (out / ".work").mkdir(parents=True)
+    batch = cluster.batch_options(out, options)
+    rows = [cluster.fit_one(str(Path(p).resolve()), n, str(out), batch) for p, n in jobs]
+    assert [r["status"] for r in rows] == ["fitted", "fitted", "bad input"], rows
+    assert "nan_vertex.obj" in rows[2]["error"]
+    again = cluster.fit_one(str(Path(jobs[0][0]).resolve()), names[0], str(out), batch)
+    assert again["status"] == "done earlier"
+    assert list((out / ".work").iterdir()) == [], "nothing half made is left"
+    cluster.write_summary(out, rows, jobs)
+
+    # The CLI's batch on the same meshes: the same names, files, fields and crust.
+    bout = tmp_path / "batch"
+    run("batch", f"@{manifest}", "--out", bout, "--quiet", "--", *opts, check=False)
+    for n in names[:2]:
+        ours, theirs = out / n, bout / n
+        assert sorted(p.name for p in ours.iterdir()) == sorted(p.name for p in theirs.iterdir())
+        assert (ours / f"{n}.voronoi.glb").read_bytes() == (theirs / f"{n}.voronoi.glb").read_bytes()
+        assert json.loads((ours / "batch.json").read_text()).keys() == json.loads((theirs / "batch.json").read_text()).keys()
+    with open(out / "summary.csv") as f:
+        ours = list(csv.DictReader(f))
+    with open(bout / "summary.csv") as f:
+        theirs = list(csv.DictReader(f))
+    assert list(ours[0]) == list(theirs[0]) + ["attempt_pid", "node"]
+    assert [r["name"] for r in ours] == [r["name"] for r in theirs] == names
+    assert [r["status"] for r in ours] == [r["status"] for r in theirs] == ["fitted", "fitted", "bad input"]
+    assert ours[0]["triangles"] == theirs[0]["triangles"] and ours[0]["attempt_pid"]

@@ -135,3 +135,42 @@ def test_view_errors_leave_no_page(quick_fit, tmp_path):
     r = run("view", quick_fit, "-o", tmp_path / "p.txt", check=False)
     assert r.returncode == 2 and not (tmp_path / "p.txt").exists()
     assert not list(tmp_path.glob("*.tmp*"))
+
+
+def test_python_view_writes_the_same_self_contained_page(quick_fit, tmp_path):
+    """`voronoi_fit.view` calls the same library as `voronoi-fit view`: the page is written,
+    self-contained, embeds the meshes, and equals the CLI's byte for byte (same inputs,
+    no fresh samples, so nothing random)."""
+    import base64
+    import warnings
+
+    import numpy as np
+    import voronoi_fit as vf
+
+    cli_page, py_page = tmp_path / "cli.html", tmp_path / "py.html"
+    run("view", quick_fit, "-o", cli_page, "--check-samples", "0")
+    got = vf.view(quick_fit, out=py_page, check_samples=0)
+    assert got == py_page and py_page.is_file()
+    html = py_page.read_text()
+    assert html == cli_page.read_text().replace(str(cli_page), str(py_page))
+    for needle in ('src="http', "src='http", 'href="http', "from 'http"):
+        assert needle not in html
+    # The embedded crust is the GLB's: its triangle count and vertex positions.
+    meta = json.loads(html.split('id="vf-meta">', 1)[1].split("</script>", 1)[0].replace("<\\/", "</"))
+    crust_v, crust_f = vf.load_mesh(quick_fit)
+    assert meta["meshes"]["crust"]["triangles"] == len(crust_f)
+    blob = html.split(f'id="{meta["meshes"]["crust"]["positions"]}">', 1)[1].split("</script>", 1)[0]
+    pos = np.frombuffer(base64.b64decode(blob), "<f4").reshape(-1, 3) + np.array(meta["center"])
+    assert np.allclose(np.sort(pos, axis=0), np.sort(crust_v, axis=0), atol=1e-4 * meta["radius"])
+    assert "input" in meta["meshes"] and "inside" in meta["points"]
+    # Defaults beside the crust; a lone crust warns what it left out; a missing file given
+    # explicitly raises InputError and writes nothing.
+    lone = tmp_path / "lone.glb"
+    shutil.copy(quick_fit, lone)
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("always")
+        assert vf.view(lone) == tmp_path / "lone.html"
+    assert any("no report" in str(x.message) for x in w)
+    with pytest.raises(vf.InputError, match="missing.json"):
+        vf.view(quick_fit, report=tmp_path / "missing.json", out=tmp_path / "x.html")
+    assert not (tmp_path / "x.html").exists()

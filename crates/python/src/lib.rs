@@ -1,6 +1,7 @@
 //! `voronoi_fit._native`: the Python package's native half. Every function calls the same
 //! library code as the CLI (`fit::fit` through `fit::FitOptions`, `occupancy::MeshOracle`,
-//! `delaunay3`, `crust`, `metrics`) and releases the GIL while it works.
+//! `delaunay3`, `crust`, `metrics`, `viewer`, and `jobs`' batch protocol for the Ray runner)
+//! and releases the GIL while it works.
 //!
 //! Arrays cross the boundary as little-endian bytes (`float64`, `uint32`, `uint8`), which
 //! the pure-Python half (`python/voronoi_fit/__init__.py`) makes from and turns back into
@@ -11,6 +12,8 @@
 //! message; `Error` (a `RuntimeError`) otherwise; an exception raised by the progress
 //! callback, or Ctrl-C (`KeyboardInterrupt`), stops the fit at the next step and is
 //! raised as it is.
+
+mod batch;
 
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -29,17 +32,17 @@ create_exception!(
 );
 create_exception!(_native, Error, PyRuntimeError, "A failure that is not the input's fault.");
 
-fn input_error(m: impl std::fmt::Display) -> PyErr {
+pub(crate) fn input_error(m: impl std::fmt::Display) -> PyErr {
     InputError::new_err(m.to_string())
 }
 
-fn failure(m: impl std::fmt::Display) -> PyErr {
+pub(crate) fn failure(m: impl std::fmt::Display) -> PyErr {
     Error::new_err(m.to_string())
 }
 
 /// n×3 float64 rows from little-endian bytes.
 fn rows_f64(bytes: &[u8], what: &str) -> PyResult<Vec<[f64; 3]>> {
-    if bytes.len() % 24 != 0 {
+    if !bytes.len().is_multiple_of(24) {
         return Err(input_error(format!(
             "{what}: {} bytes is not a whole number of (x, y, z) float64 rows",
             bytes.len()
@@ -57,7 +60,7 @@ fn rows_f64(bytes: &[u8], what: &str) -> PyResult<Vec<[f64; 3]>> {
 
 /// n×3 uint32 rows from little-endian bytes.
 fn rows_u32(bytes: &[u8], what: &str) -> PyResult<Vec<[u32; 3]>> {
-    if bytes.len() % 12 != 0 {
+    if !bytes.len().is_multiple_of(12) {
         return Err(input_error(format!("{what}: {} bytes is not a whole number of uint32 triples", bytes.len())));
     }
     Ok(bytes
@@ -177,7 +180,7 @@ fn fit_mesh<'py>(
     let input = mesh(vertices, faces, name)?;
     let options: FitOptions =
         serde_json::from_str(options_json).map_err(|e| input_error(format!("fit options: {e}")))?;
-    let mut config = options.to_config(name).map_err(|e| input_error(e))?;
+    let mut config = options.to_config(name).map_err(input_error)?;
     // float64 unless asked: the CLI rounds (and checks again) at float32 only for glTF, and
     // so does `float32` here, for a crust that will be saved as GLB.
     config.output_precision = if float32 { ::crust::output::Precision::F32 } else { ::crust::output::Precision::F64 };
@@ -352,6 +355,42 @@ fn evaluate(py: Python<'_>, vr: &[u8], fr: &[u8], vp: &[u8], fp: &[u8]) -> PyRes
     serde_json::to_string(&report).map_err(failure)
 }
 
+/// The viewer page of a crust (`viewer::write_page`, as `voronoi-fit view`): paths of the
+/// crust and, optionally, the input, report, sites file, cells and page; the fresh samples
+/// checked for misclassified points. Returns (the page's path, notes on what it left out).
+#[pyfunction]
+#[pyo3(signature = (crust, input=None, report=None, sites=None, cells=None, out=None, check_samples=::viewer::DEFAULT_CHECK_SAMPLES))]
+#[allow(clippy::too_many_arguments)]
+fn view(
+    py: Python<'_>,
+    crust: &str,
+    input: Option<&str>,
+    report: Option<&str>,
+    sites: Option<&str>,
+    cells: Option<&str>,
+    out: Option<&str>,
+    check_samples: usize,
+) -> PyResult<(String, Vec<String>)> {
+    let path = |p: Option<&str>| p.map(std::path::PathBuf::from);
+    let options = ::viewer::PageOptions {
+        crust: crust.into(),
+        input: path(input),
+        report: path(report),
+        sites: path(sites),
+        cells: path(cells),
+        output: path(out),
+        check_samples,
+    };
+    let page = py.allow_threads(|| ::viewer::write_page(&options)).map_err(|e| {
+        if e.is_input_fault() {
+            input_error(e)
+        } else {
+            failure(e)
+        }
+    })?;
+    Ok((page.path.display().to_string(), page.notes))
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", m.py().get_type::<InputError>())?;
@@ -366,5 +405,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(save_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(save_sites, m)?)?;
+    m.add_function(wrap_pyfunction!(view, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_finished, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_fit_into, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_publish, m)?)?;
+    m.add_function(wrap_pyfunction!(batch::batch_write_summary, m)?)?;
     Ok(())
 }

@@ -41,6 +41,7 @@ __all__ = [
     "load_mesh",
     "save_mesh",
     "signed_distance",
+    "view",
     "winding_number",
 ]
 
@@ -139,6 +140,39 @@ def save_mesh(path: "str | os.PathLike[str]", vertices: Any, faces: Any, normals
     ``merge_vertices(merge_norm=True)``)."""
     v, f = _rows(vertices, "vertices"), _faces(faces, "faces")
     _native.save_mesh(os.fspath(path), v.tobytes(), f.tobytes(), normals)
+
+
+def view(
+    crust: "str | os.PathLike[str]",
+    input: "Optional[str | os.PathLike[str]]" = None,
+    report: "Optional[str | os.PathLike[str]]" = None,
+    sites: "Optional[str | os.PathLike[str]]" = None,
+    out: "Optional[str | os.PathLike[str]]" = None,
+    cells: "Optional[str | os.PathLike[str]]" = None,
+    check_samples: int = 200_000,
+) -> "Path":
+    """Write the offline viewer page of a crust, as ``voronoi-fit view`` does: one
+    self-contained HTML file (three.js inlined, meshes embedded) showing the input and the
+    crust, the sites, misclassified sample points, the cells, the loss curve and timings.
+
+    Files not given are looked for beside the crust (``OUT.report.json``,
+    ``OUT.sites.npz``, ``OUT.cells.glb``; the input is the path the report names); a
+    missing one only leaves its part out. ``out`` defaults to ``OUT.html`` beside the
+    crust. ``check_samples`` fresh samples are classified by the sites to find
+    misclassified points (0: none). Returns the page's path; each part left out is a
+    ``UserWarning`` saying why (as the CLI's notes on stderr).
+
+    Raises :class:`InputError` when a file given is missing or malformed."""
+    import warnings
+    from pathlib import Path
+
+    opt = lambda p: None if p is None else os.fspath(p)  # noqa: E731
+    path, notes = _native.view(
+        os.fspath(crust), opt(input), opt(report), opt(sites), opt(cells), opt(out), check_samples
+    )
+    for n in notes:
+        warnings.warn(f"{n}; the page leaves that part out", stacklevel=2)
+    return Path(path)
 
 
 def _atomic_text(path: str, text: str) -> None:

@@ -1,5 +1,6 @@
 # Type stub of voronoi_fit (the package's docstrings say what each function does).
 import os
+from pathlib import Path
 from typing import Any, Callable, Optional, Tuple, Union
 
 import numpy as np
@@ -82,3 +83,12 @@ def hausdorff(
     VA: Any, FA: Any, VB: Optional[npt.ArrayLike] = None, FB: Optional[npt.ArrayLike] = None, rel_tolerance: float = 1e-6
 ) -> Tuple[float, float]: ...
 def evaluate(reference: MeshLike, prediction: MeshLike) -> dict[str, Any]: ...
+def view(
+    crust: Union[str, os.PathLike[str]],
+    input: Optional[Union[str, os.PathLike[str]]] = None,
+    report: Optional[Union[str, os.PathLike[str]]] = None,
+    sites: Optional[Union[str, os.PathLike[str]]] = None,
+    out: Optional[Union[str, os.PathLike[str]]] = None,
+    cells: Optional[Union[str, os.PathLike[str]]] = None,
+    check_samples: int = 200000,
+) -> Path: ...

@@ -8,17 +8,21 @@
 - ``manifest.txt`` names one mesh per line (``#`` comments; relative paths are taken from
   the manifest's folder). Every worker must see the same paths and ``DIR``: a shared file
   system (NFS, a cloud file store mounted on every node), not a node's local disk.
-- Each task fits one mesh with :func:`voronoi_fit.fit` in ``DIR/.work/NAME.ATTEMPT/`` and
-  publishes it with one ``rename`` to ``DIR/NAME/`` (crust GLB, sites file, report,
-  ``batch.json``), the layout ``voronoi-fit batch`` writes. The rename is the commit: if a
-  retried attempt finds ``DIR/NAME/`` already there, it discards its own copy, so every
-  mesh is published exactly once and never half.
+- The batch protocol is ``voronoi-fit batch``'s own, the Rust ``jobs::batch`` module called
+  through the native module: the folder names, ``batch.json`` (what a result was made
+  from), the fit itself, publishing by rename and ``summary.csv``. Each task fits one mesh
+  in its private ``DIR/.work/NAME.ATTEMPT/`` and publishes it with one ``rename`` to
+  ``DIR/NAME/`` (crust GLB, sites file, picture, report, ``batch.json``), the layout
+  ``voronoi-fit batch`` writes. The rename is the commit: if a retried attempt finds
+  ``DIR/NAME/`` already there, it discards its own copy, so every mesh is published
+  exactly once and never half.
 - A task whose worker dies (killed, out of memory, node lost) is run again by Ray
   (``--retries``, default 3); a mesh the fit rejects is recorded as ``bad input`` with the
   message and not retried. Meshes already published with the same input and options are
   skipped, so a rerun finishes what a stopped run left.
-- The driver gathers every task's row into ``DIR/summary.csv`` (rewritten atomically as
-  tasks finish) and prints meshes per minute and the engine's overhead (wall time × task
+- The driver gathers every task's row into ``DIR/summary.csv`` (``voronoi-fit batch``'s
+  columns, then the attempt's process id and node; rewritten atomically as tasks finish)
+  and prints meshes per minute and the engine's overhead (wall time × task
   slots against the time spent inside fits).
 
 Ray is the engine (``pip install "voronoi-fit[cluster]"``); nothing here schedules work
@@ -28,9 +32,6 @@ itself.
 from __future__ import annotations
 
 import argparse
-import csv
-import hashlib
-import io
 import json
 import os
 import shutil
@@ -40,173 +41,92 @@ import uuid
 from pathlib import Path
 from typing import Any, Optional
 
-FIELDS = [
-    "name",
-    "input",
-    "status",
-    "error",
-    "seconds",
-    "attempt_pid",
-    "node",
-    "hausdorff_hi",
-    "hausdorff_of_diagonal",
-    "chamfer_l1",
-    "fscore",
-    "normal_consistency",
-    "iou",
-    "sites",
-    "triangles",
-    "genus",
-    "folder",
-]
+# The runner's own columns of summary.csv, after voronoi-fit batch's.
+EXTRA_FIELDS = ["attempt_pid", "node"]
 
 
-def read_manifest(path: Path) -> list[Path]:
-    """Mesh paths of a manifest, in order, without repeats."""
-    out, seen = [], set()
-    base = path.parent
-    for n, line in enumerate(path.read_text().splitlines(), 1):
-        line = line.strip()
-        if not line or line.startswith("#"):
-            continue
-        p = Path(line)
-        p = p if p.is_absolute() else base / p
-        if not p.is_file():
-            raise SystemExit(f"error: {path}, line {n}: `{line}` is not a file (paths are relative to the manifest)")
-        key = p.resolve()
-        if key not in seen:
-            seen.add(key)
-            out.append(p)
-    return out
+def plan(manifest: Path) -> list[tuple[str, str]]:
+    """The manifest's meshes as (path, folder name) pairs, in order, without repeats, named
+    exactly as ``voronoi-fit batch`` names them (the Rust protocol's plan)."""
+    from voronoi_fit import InputError, _native
+
+    try:
+        return _native.batch_plan([f"@{manifest}"])
+    except InputError as e:
+        raise SystemExit(f"error: {e}") from None
 
 
-def names(paths: list[Path]) -> list[str]:
-    """Output folder names exactly as `voronoi-fit batch` makes them: the stem, made safe;
-    stems shared by several inputs get the low 32 bits of FNV-1a of the resolved path."""
+def batch_options(out: Path, options: dict) -> str:
+    """The batch's options for the Rust protocol, as JSON: the fit options (the CLI's long
+    names), GLB crusts, and the options as flags recorded in each ``batch.json``."""
+    from voronoi_fit import __version__
 
-    def stem(p: Path) -> str:
-        s = "".join(c if (c.isalnum() or c in "-_.") else "_" for c in p.stem)
-        return s if s and not s.startswith(".") else f"mesh{s}"
-
-    counts: dict[str, int] = {}
-    for p in paths:
-        counts[stem(p)] = counts.get(stem(p), 0) + 1
-    out = []
-    for p in paths:
-        s = stem(p)
-        if counts[s] > 1:
-            s = f"{s}-{_fnv1a64(str(p.resolve()).encode()) & 0xFFFFFFFF:08x}"
-        out.append(s)
-    return out
-
-
-def _fnv1a64(data: bytes) -> int:
-    """FNV-1a, 64 bits: the hash `voronoi-fit batch` puts in shared stems' folder names."""
-    h = 0xCBF29CE484222325
-    for b in data:
-        h = ((h ^ b) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
-    return h
+    fit_args = []
+    for k in sorted(options):
+        fit_args += [f"--{k.replace('_', '-')}", str(options[k])]
+    return json.dumps(
+        {
+            "out": str(out),
+            "jobs": 1,
+            "format": "glb",
+            "fit": {"options": options},
+            "fit_args": fit_args,
+            "version": __version__,
+        }
+    )
 
 
-def provenance(path: Path, options: dict) -> dict:
-    data = path.read_bytes()
-    return {
-        "input": str(path.resolve()),
-        "input_bytes": len(data),
-        "input_sha256": hashlib.sha256(data).hexdigest(),
-        "fit_options": options,
-        "format": "glb",
-    }
-
-
-def fit_one(path: str, name: str, out: str, options: dict) -> dict:
-    """One mesh, on a worker: fit, write into a private work folder, publish by rename.
-    Returns the summary row. Bad input is a row, not an exception (no retry)."""
-    import voronoi_fit as vf
+def fit_one(path: str, name: str, out: str, batch: str) -> dict:
+    """One mesh, on a worker: fit into a private work folder, publish by rename (the Rust
+    protocol). Returns the summary row. Bad input is a row, not an exception (no retry)."""
+    from voronoi_fit import InputError, _native
 
     t0 = time.time()
-    p, out_dir = Path(path), Path(out)
+    out_dir = Path(out)
     row: dict[str, Any] = {"name": name, "input": path, "attempt_pid": os.getpid(), "node": os.uname().nodename}
-    final = out_dir / name
-    prov = provenance(p, options)
-    if _matches(final, prov):
-        return {**row, "status": "done earlier", **_figures(final, name)}
-    work = out_dir / ".work" / f"{name}.{uuid.uuid4().hex[:12]}"
+    if _native.batch_finished(batch, path, name):
+        return {**row, "status": "done earlier", "finished": True}
+    attempt = uuid.uuid4().hex[:12]
+    work = out_dir / ".work" / f"{name}.{attempt}"
     work.mkdir(parents=True)
     # Tell whoever watches (the test kills the worker named here) which process works.
     (work / "attempt.pid").write_text(str(os.getpid()))
     try:
-        result = vf.fit(p, progress=False, float32=True, name=path, **options)
-    except vf.InputError as e:
+        _native.batch_fit_into(batch, path, name, str(work))
+    except InputError as e:
         shutil.rmtree(work, ignore_errors=True)
         return {**row, "status": "bad input", "error": str(e), "seconds": f"{time.time() - t0:.1f}"}
-    result.save(work / f"{name}", format="glb")
     (work / "attempt.pid").unlink()
-    _atomic_json(work / "batch.json", prov)
-    try:
-        os.rename(work, final)
-        status = "fitted"
-    except OSError:
-        # Another attempt published first (this one was a retry that raced it), or an older
-        # result with other settings is in the way: keep exactly one.
-        if _matches(final, prov):
-            shutil.rmtree(work, ignore_errors=True)
-            status = "fitted (another attempt published first)"
-        else:
-            old = out_dir / ".work" / f"{name}.replaced.{uuid.uuid4().hex[:8]}"
-            os.rename(final, old)
-            os.rename(work, final)
-            shutil.rmtree(old, ignore_errors=True)
-            status = "fitted"
-    return {**row, "status": status, "seconds": f"{time.time() - t0:.1f}", **_figures(final, name)}
+    aside = out_dir / ".work" / f"{name}.replaced.{attempt}"
+    moved = _native.batch_publish(batch, path, name, str(work), str(aside))
+    status = "fitted" if moved else "fitted (another attempt published first)"
+    return {**row, "status": status, "seconds": f"{time.time() - t0:.1f}", "finished": True}
 
 
-def _matches(folder: Path, prov: dict) -> bool:
-    try:
-        return json.loads((folder / "batch.json").read_text()) == prov and (
-            folder / f"{folder.name}.voronoi.report.json"
-        ).is_file()
-    except (OSError, ValueError):
-        return False
+def write_summary(out: Path, rows: list[dict], jobs: list[tuple[str, str]]) -> None:
+    """``summary.csv`` by the Rust protocol: one row per finished task, in manifest order,
+    with the report's figures and the attempt's process id and node."""
+    from voronoi_fit import _native
 
-
-def _figures(folder: Path, name: str) -> dict:
-    try:
-        r = json.loads((folder / f"{name}.voronoi.report.json").read_text())
-    except (OSError, ValueError):
-        return {}
-    m = r.get("metrics") or {}
-    h, s, c = m.get("hausdorff") or {}, m.get("surface") or {}, r.get("crust") or {}
-    return {
-        "hausdorff_hi": h.get("hi", ""),
-        "hausdorff_of_diagonal": (h["hi"] / h["diagonal"]) if h.get("diagonal") else "",
-        "chamfer_l1": s.get("chamfer_l1", ""),
-        "fscore": s.get("fscore", ""),
-        "normal_consistency": s.get("normal_consistency", ""),
-        "iou": (m.get("iou") or {}).get("iou", ""),
-        "sites": c.get("num_sites", ""),
-        "triangles": c.get("num_triangles", ""),
-        "genus": c.get("genus", ""),
-        "folder": str(folder),
-        "seconds": r.get("total_seconds", ""),
-    }
+    inputs = dict((n, p) for p, n in jobs)
+    summary = [
+        {
+            "job": {"input": r.get("input") or inputs.get(r["name"], ""), "name": r["name"]},
+            "status": str(r.get("status", "")),
+            "error": str(r.get("error", "")).replace("\n", " "),
+            "seconds": str(r.get("seconds", "")),
+            "finished": bool(r.get("finished")),
+            "extra": [str(r.get(k, "")) for k in EXTRA_FIELDS],
+        }
+        for r in rows
+    ]
+    _native.batch_write_summary(str(out), json.dumps(summary), EXTRA_FIELDS)
 
 
 def _atomic_json(path: Path, obj: Any) -> None:
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex[:8]}")
     tmp.write_text(json.dumps(obj, indent=2))
     os.replace(tmp, path)
-
-
-def write_summary(out: Path, rows: list[dict]) -> None:
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=FIELDS, extrasaction="ignore")
-    w.writeheader()
-    for r in rows:
-        w.writerow(r)
-    tmp = out / f".summary.csv.{uuid.uuid4().hex[:8]}"
-    tmp.write_text(buf.getvalue())
-    os.replace(tmp, out / "summary.csv")
 
 
 def run(
@@ -222,10 +142,9 @@ def run(
     rows (input order)."""
     import ray
 
-    paths = read_manifest(manifest)
-    if not paths:
-        raise SystemExit(f"error: {manifest}: no meshes listed")
+    jobs = plan(manifest)
     out.mkdir(parents=True, exist_ok=True)
+    batch = batch_options(out.resolve(), options)
     (out / ".work").mkdir(exist_ok=True)
     t0 = time.time()
     if address == "local":
@@ -235,10 +154,10 @@ def run(
     slots = max(1, int(ray.cluster_resources().get("CPU", 1) // cpus_per_task))
     task = ray.remote(num_cpus=cpus_per_task, max_retries=retries, retry_exceptions=False)(fit_one)
     refs = {}
-    for p, n in zip(paths, names(paths)):
-        refs[task.remote(str(p.resolve()), n, str(out.resolve()), options)] = n
+    for p, n in jobs:
+        refs[task.remote(str(Path(p).resolve()), n, str(out.resolve()), batch)] = n
     rows: dict[str, dict] = {}
-    order = names(paths)
+    order = [n for _, n in jobs]
     pending = list(refs)
     bar = None
     if not quiet:
@@ -258,7 +177,7 @@ def run(
                 rows[n] = {"name": n, "status": "failed", "error": f"{type(e).__name__}: {e}".replace("\n", " ")[:500]}
             if bar is not None:
                 bar.update(1)
-        write_summary(out, [rows[n] for n in order if n in rows])
+        write_summary(out, [rows[n] for n in order if n in rows], jobs)
     if bar is not None:
         bar.close()
     wall = time.time() - t0
@@ -267,7 +186,7 @@ def run(
     for leftover in (out / ".work").iterdir():
         shutil.rmtree(leftover, ignore_errors=True)
     final = [rows[n] for n in order]
-    write_summary(out, final)
+    write_summary(out, final, jobs)
     fitted = [r for r in final if str(r.get("status", "")).startswith("fitted")]
     inside = sum(float(r.get("seconds") or 0) for r in fitted)
     stats = {
