@@ -15,7 +15,7 @@ use crate::cli_error::{CliError, InFile};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Sites file (.npz with sites, labels, transform, format_version; see the README).
+    /// Sites file (.npz with sites, labels, transform, format_version; see docs/reports.md).
     pub sites: PathBuf,
     /// Output crust: .glb, .gltf, .obj or .ply (by extension).
     #[arg(short, long)]

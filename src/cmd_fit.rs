@@ -154,7 +154,7 @@ pub struct Args {
     /// if it is at least as good on all four metrics against the input (Hausdorff
     /// distances both within the F-score's τ, 0.3% of the diagonal, or with overlapping
     /// certified intervals count as equal; report: polish_choice); 0: VoroLoss alone, as VoroMesh (faster); W > 0: always weight W
-    /// (README, *Lined-up pairs*).
+    /// (docs/main-job.md, *Polish*).
     #[arg(long)]
     pub polish_align: Option<f64>,
     /// No surface polish after training.
@@ -317,7 +317,7 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.json {
         crate::output::out!("{}", done.json);
     } else {
-        // How viewers will shade a glTF crust (README, *Looking at the result*).
+        // How viewers will shade a glTF crust (docs/viewer.md).
         let gltf = matches!(
             mesh_io::OutputFormat::from_path(&done.outputs.mesh),
             Ok(mesh_io::OutputFormat::Glb | mesh_io::OutputFormat::Gltf)

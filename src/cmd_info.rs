@@ -10,7 +10,7 @@ use crate::cli_error::CliError;
 pub struct Args {
     /// Mesh file: .obj, .stl, .ply, .off, .gltf or .glb.
     pub mesh: PathBuf,
-    /// Print the report as JSON (stable layout, documented in the README).
+    /// Print the report as JSON (stable layout, documented in docs/reports.md).
     #[arg(long)]
     pub json: bool,
     /// Before the report, merge vertices at most this fraction of the bounding-box diagonal

@@ -130,7 +130,7 @@ pub struct TrainOptions {
     #[arg(long)]
     pub lr: Option<f64>,
     /// β of the soft-Voronoi, in 1/unit-square lengths (default 100; the seed's is 10,000,
-    /// see the README).
+    /// see docs/mnist.md).
     #[arg(long)]
     pub beta: Option<f64>,
     /// Anneal β geometrically from this value at the first step to --beta at the last.

@@ -22,7 +22,7 @@ macro_rules! out {
 }
 pub(crate) use out;
 
-/// The help of `--normals`, shared by `fit`, `crust` and `convert` (README, *Looking at the
+/// The help of `--normals`, shared by `fit`, `crust` and `convert` (docs/viewer.md, *How the GLB shades
 /// result*). A constant rather than a flattened argument struct: the main job's arguments
 /// are themselves flattened, optionally, into the top-level parser, and clap does not see
 /// a nested flattened group's arguments there (`voronoi-fit MESH --normals crease` was

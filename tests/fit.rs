@@ -82,8 +82,8 @@ fn main_job_runs_on_every_shared_mesh_and_asset() {
 }
 
 /// The target: default settings on the bundled bunny misclassify at most 1% of the
-/// fresh samples (the upper end of the 95% interval), with a watertight crust. (Its time, ≤ 60 s, is measured in the README,
-/// not asserted here.)
+/// fresh samples (the upper end of the 95% interval), with a watertight crust. (Its time is measured by
+/// benches/main_job_times.py, not asserted here.)
 #[test]
 fn default_bunny_fit_meets_the_accuracy_target() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,5 +1,5 @@
 //! Times the crust of ball-labelled uniform sites against its Delaunay tetrahedralization,
-//! best of 5 runs each, and prints the ratio (the README's figure).
+//! best of 5 runs each, and prints the ratio (docs/performance.md).
 //!
 //!     cargo run --release -p crust --example crust_timing -- 100000
 

@@ -29,7 +29,7 @@ pub struct SceneMesh<'a> {
 
 /// The vertex normals a glTF file carries, which is how viewers shade it.
 ///
-/// Measured on crusts (`benches/render.py --smooth`, README *Looking at the result*): with one
+/// Measured on crusts (`benches/render.py --smooth`, docs/viewer.md): with one
 /// area-weighted normal per vertex, every sharp edge of a CAD part shades as a ragged,
 /// blotchy band, because a crust vertex on an edge averages faces of both sides and the
 /// crust's small faces at odd angles there; a vertex can hold only one normal, so no choice
@@ -89,7 +89,7 @@ impl std::fmt::Display for Normals {
 }
 
 /// The crease angle of plain `crease`: above the ~27° at which a crust's faces between
-/// neighbouring pairs lean on smooth shapes (README, *Lined-up pairs*), so those shade
+/// neighbouring pairs lean on smooth shapes (docs/main-job.md, *Polish*), so those shade
 /// smooth, and well below the 90° of a CAD part's edges.
 pub const DEFAULT_CREASE_DEGREES: f64 = 40.0;
 

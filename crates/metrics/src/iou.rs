@@ -12,7 +12,7 @@
 //! a closed mesh it counts the signed crossings of a segment to the outside (every decision
 //! an exact `orient3d`), elsewhere it is the fast winding number with the exact band. A
 //! crust is always closed, and so are most inputs, so both meshes usually take the
-//! crossing path (the Menger sponge's labels 6.5× faster; README, "Occupancy").
+//! crossing path (the Menger sponge's labels 6.5× faster; docs/performance.md, *Inside/outside labels*).
 
 use mesh_io::TriMesh;
 use occupancy::{Config, MeshOracle};

@@ -1,6 +1,6 @@
 //! One method trained on the first IMAGES training digits for EPOCHS epochs, then its
 //! training curve and its table row on test digits 1–1,000 (or, for fewer than 100
-//! images, on the training digits themselves): the runs behind the README's β and
+//! images, on the training digits themselves): the runs behind the β and
 //! signed-distance ablation (`benches/mnist_ablation.sh`).
 //!
 //! `cargo run --release -p vf-mnist --example mnist_probe -- METHOD IMAGES EPOCHS [LR]

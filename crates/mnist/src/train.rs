@@ -73,7 +73,7 @@ impl TrainSettings {
     ///
     /// The Voronoi decoder's loss: the seed's four terms with the signed-distance weight at
     /// 10, and β = 100, not the seed's 10,000 (`--beta 10000` gives it). Measured on the
-    /// 10,000 training digits (README): at β = 10,000 the reconstruction gradient only
+    /// 10,000 training digits (docs/mnist.md): at β = 10,000 the reconstruction gradient only
     /// exists within ~1/β of the crust, is zero for a wrongly labelled point farther away,
     /// and comes in rare spikes of size ~β that dominate Adam's second moment; the decoder
     /// then learns almost nothing (103.6 mismatched pixels after 5 epochs, about an empty

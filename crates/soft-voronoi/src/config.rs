@@ -134,7 +134,7 @@ fn default_selection_batch() -> usize {
 
 impl TrainConfig {
     /// The default, measured on the bundled bunny, spot, featuretype and the quality
-    /// benchmark (see the README's ablation table): mirrored pairs at well-spread surface
+    /// benchmark (the ablation in CHANGELOG.md): mirrored pairs at well-spread surface
     /// points ([`Init::Pairs`], δ = the local spacing), the seed's reconstruction and bounds
     /// losses with the surface term (surface samples pulled onto the bisector of their
     /// nearest inside and outside sites, with normal alignment of weight 1: measured against
@@ -180,7 +180,7 @@ impl TrainConfig {
     ///
     /// With the surface polish after it, 200 steps from 3e-4 measured as well as 600 from
     /// 1e-4 on the 16 meshes of the quality benchmark (some metrics better, some worse, by
-    /// about as much as a change of seed moves them; README, "Surface quality") in a third
+    /// about as much as a change of seed moves them; docs/quality.md) in a third
     /// of the training time; 200 from 1e-4 and 100 from 6e-4 were worse on more of the eight
     /// meshes they were tried on.
     pub fn default_lr(num_sites: usize) -> f64 {

@@ -18,7 +18,7 @@
 //! within ~1/β of the crust, so they place the crust but hardly orient its faces; the
 //! bisector distance is a direct, dense signal on every face near the surface. Measured on
 //! the quality benchmark it raises normal consistency and lowers Chamfer on every mesh
-//! (README, "Surface quality").
+//! (docs/quality.md).
 //!
 //! The neighbours are found with [`crate::knn::KnnTree`] (exact) and held fixed for the gradient, as in the paper;
 //! the gradient is analytic (checked against finite differences in the tests). The run is
@@ -77,7 +77,7 @@ pub struct PolishConfig {
     pub seed: u64,
     /// The label-aware alignment term over the first steps ([`Alignment`]); `None` (the
     /// default: it trades Hausdorff distance on CAD parts and thin parts for normals on
-    /// smooth shapes, README *Lined-up pairs*): VoroLoss alone, as VoroMesh.
+    /// smooth shapes, docs/main-job.md, *Polish*): VoroLoss alone, as VoroMesh.
     #[serde(default)]
     pub alignment: Option<Alignment>,
 }
@@ -123,7 +123,7 @@ pub struct Alignment {
 
 impl Default for Alignment {
     /// Measured on libigl's sphere, 3holes and bunny and on featuretype (K = 8,192); the
-    /// README's *Lined-up pairs* has the table.
+    /// docs/main-job.md, *Polish*, says what it buys.
     fn default() -> Self {
         Alignment { distance_weight: 1.0, normal_weight: 0.3, share: 0.5, min_cos: 40f64.to_radians().cos() }
     }

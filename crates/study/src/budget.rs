@@ -71,7 +71,7 @@ impl Budget {
             voronoi_eval_samples: 100_000,
             // 256×3 (132,865 parameters) trained to its plateau takes 5–10 minutes per seed
             // here (OccNet: 5,800 steps), which three seeds of both decoders cannot afford
-            // within the study's 45 minutes; its single-seed figures are in the README.
+            // within the study's 45 minutes.
             mlp_sizes: vec![(4, 2), (8, 2), (16, 3), (32, 3), (64, 3), (128, 3)],
             decoders: vec!["occnet".into(), "deepsdf".into()],
             references: true,
