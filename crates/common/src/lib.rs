@@ -5,6 +5,8 @@
 //!   number by hand;
 //! - [`adam`]: the Adam optimiser's settings and update, used by the soft-Voronoi
 //!   trainer (f64 sites) and the MLP baselines (f32/f64 weights);
+//! - [`vec3`]: the f64 vector helpers on `[f64; 3]` (sub, dot, cross, norm, …) the
+//!   crates share, each in one fixed evaluation order;
 //! - [`npz`] (feature `npz`, on by default): an uncompressed `.npz` built in memory and
 //!   written atomically (sites files, checkpoints, CLI outputs).
 
@@ -12,6 +14,7 @@ pub mod adam;
 #[cfg(feature = "npz")]
 pub mod npz;
 pub mod rng;
+pub mod vec3;
 
 pub use adam::AdamParams;
 pub use rng::{ChunkRng, SplitMix64, Stream};

@@ -10,20 +10,9 @@
 use std::collections::{HashMap, HashSet};
 
 use mesh_io::TriMesh;
+use vf_common::vec3::{cross, dot, sub, V3 as V};
 
 use crate::error::CrustError;
-
-type V = [f64; 3];
-
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: V, b: V) -> V {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// Newell normal of a polygon (not normalised).
 fn newell(poly: &[u32], pos: &[V]) -> V {

@@ -23,67 +23,11 @@
 use crust::{Crust, CrustConfig};
 use mesh_io::TriMesh;
 use occupancy::{BvhPreset, MeshOracle};
-use serde::Serialize;
 use soft_voronoi::Solid;
+use vf_common::vec3::{distance_squared, dot};
 
 use crate::error::FitError;
-
-/// What [`carve`] did (report field `carving`).
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct CarveReport {
-    /// The tolerance, unit-cube lengths (and as a share of the diagonal).
-    pub tolerance: f64,
-    /// The same as a share of the input's bounding-box diagonal.
-    pub tolerance_of_diagonal: f64,
-    /// Sites inserted, per round.
-    pub inserted_per_round: Vec<usize>,
-    /// Of those, the sites of pairs at input samples far from the crust (the rest are at
-    /// the feet of crust vertices far from the input), per round.
-    pub inserted_at_input_per_round: Vec<usize>,
-    /// Of those, the mirror images of inserted sites across input faces near them
-    /// ([`mirror_closure`]), per round.
-    pub inserted_as_mirrors_per_round: Vec<usize>,
-    /// Why carving was run again without the mirrors, if it was: the crust with them could
-    /// not be written in the output's precision (the main job then carves again from the
-    /// same sites without them).
-    pub mirrors_dropped: Option<String>,
-    /// Farthest crust vertex from the input before and after, unit-cube lengths.
-    pub farthest_before: f64,
-    /// After the last kept round.
-    pub farthest_after: f64,
-    /// The farthest crust vertex after each extraction: before any insertion, then after
-    /// each round run (kept or undone).
-    pub farthest_per_round: Vec<f64>,
-    /// The input's farthest point from the crust after each extraction (the other side of
-    /// the Hausdorff distance: dents; certified to 0.01% of the diagonal, upper end; where
-    /// part of the input is buried inside its solid, the largest over 100,000 samples of
-    /// the rest).
-    pub input_farthest_per_round: Vec<f64>,
-    /// The crust's F-score against the input at the tolerance after each extraction (from
-    /// samples; a state more than [`f_slack`] below the first is not kept: 0.002, or a
-    /// twentieth of what the first lacks of 1 where that is more).
-    pub fscore_per_round: Vec<f64>,
-    /// Rounds run but undone: the best state (see `best_state`: least two-sided farthest
-    /// distance, then least farthest vertex, then least summed excess of the stray
-    /// vertices) came before them.
-    pub undone_rounds: usize,
-    /// The uncarved crust's Chamfer L1 distance and normal consistency against the input
-    /// (from the samples of the F-score; unit-cube lengths).
-    pub first_surface: SurfaceBar,
-    /// Whether carving stopped before its first round because the uncarved crust did not
-    /// reach [`CarveOptions::gate`].
-    pub gated: bool,
-}
-
-/// Chamfer L1 distance (unit-cube lengths) and normal consistency of a crust against the
-/// input, from the samples of carving's F-score.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct SurfaceBar {
-    /// Chamfer L1.
-    pub chamfer_l1: f64,
-    /// Normal consistency.
-    pub normal_consistency: f64,
-}
+pub use crate::report::{CarveReport, SurfaceBar};
 
 /// How [`carve`] runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -123,7 +67,8 @@ pub const ROUNDS: usize = 8;
 /// [`CarveReport::undone_rounds`]).
 ///
 /// # Errors
-/// [`FitError::Failure`] when a crust cannot be extracted.
+/// [`FitError::Crust`] when a crust cannot be extracted; [`FitError::Occupancy`] or
+/// [`FitError::Metrics`] when a distance cannot be measured.
 pub fn carve(
     sites: &mut Vec<[f64; 3]>,
     labels: &mut Vec<bool>,
@@ -145,12 +90,14 @@ pub fn carve(
     let certify = metrics::CertifiedOptions { rel_tolerance: 1e-4, ..Default::default() };
     let surface_options =
         metrics::SurfaceOptions { num_samples: F_SAMPLES, seed: 0, fscore_tau_rel: tolerance / mesh.diagonal() };
-    let input = metrics::DistanceMesh::with_preset(mesh, "input", BvhPreset::VeryFast).map_err(failure)?;
+    let input = metrics::DistanceMesh::with_preset(mesh, "input", BvhPreset::VeryFast).map_err(measure_failure)?;
     let samples = unburied_samples(mesh, solid)?;
     let sample_index = (!samples.points.is_empty()).then(|| soft_voronoi::SiteIndex::new(&samples.points));
+    // One function for all rounds (about 120 lines): each round's measurements, its
+    // choice of strays and its insertions share the budget, the states and the report.
     for round in 0..=rounds {
         let crust = Crust::extract(sites, labels, &CrustConfig::default())
-            .map_err(|e| FitError::Failure(format!("crust while carving: {e}")))?;
+            .map_err(|source| FitError::Crust { during: "crust while carving", source })?;
         let far = oracle.closest_points(&crust.mesh.positions).map_err(failure)?;
         let farthest = far.iter().map(|c| c.squared_distance.sqrt()).fold(0.0, f64::max);
         let excess: f64 = far.iter().map(|c| (c.squared_distance.sqrt() - tolerance).max(0.0)).sum();
@@ -158,16 +105,19 @@ pub fn carve(
         // inserted outside site's cell cut into the solid); then the rest of the surface:
         // the F-score at the tolerance, from samples on both.
         let crust_distance =
-            metrics::DistanceMesh::with_preset(&crust.mesh, "crust", BvhPreset::VeryFast).map_err(failure)?;
+            metrics::DistanceMesh::with_preset(&crust.mesh, "crust", BvhPreset::VeryFast).map_err(measure_failure)?;
         let sample_distance = distances_to(&samples.points, &crust_distance);
         // Where part of the input is buried in its solid, the largest distance of the
         // samples of the rest; else certified.
         let missed = if samples.any_buried {
             sample_distance.iter().copied().fold(0.0, f64::max)
         } else {
-            metrics::hausdorff::directed_certify_prepared(&input, &crust_distance, &certify).map_err(failure)?.hi
+            metrics::hausdorff::directed_certify_prepared(&input, &crust_distance, &certify)
+                .map_err(measure_failure)?
+                .hi
         };
-        let surface = metrics::surface_metrics_of(&input, &crust_distance, &surface_options).map_err(failure)?;
+        let surface =
+            metrics::surface_metrics_of(&input, &crust_distance, &surface_options).map_err(measure_failure)?;
         let fscore = surface.fscore;
         if round == 0 {
             report.first_surface =
@@ -193,67 +143,14 @@ pub fn carve(
         // tunnels) and the input's samples far from the crust (dents, tunnels filled in,
         // parts lost), farther than the tolerance and within WORST_SHARE of the worst.
         let threshold = tolerance.max(WORST_SHARE * farthest.max(missed));
-        let mut stray: Vec<Stray> = far
-            .iter()
-            .zip(&crust.mesh.positions)
-            .filter(|(c, _)| c.squared_distance.sqrt() > threshold)
-            .map(|(c, &v)| {
-                let d = c.squared_distance.sqrt();
-                // The pair lies along the stray vertex's own direction from its foot.
-                // Where the foot is inside a triangle that is the triangle's normal; at an
-                // edge or a corner (a spike off a plate's rim, a CAD part's corner) it is
-                // the direction the spike actually takes, which a neighbouring face's
-                // normal is not.
-                let direction = if d > 0.0 {
-                    [0, 1, 2].map(|i| (v[i] - c.point[i]) / d)
-                } else {
-                    soft_voronoi::solid::unit_normal(mesh, c.triangle as usize)
-                };
-                Stray { distance: d, foot: c.point, direction, triangle: c.triangle, at_input: false }
-            })
-            .collect();
-        // An input sample far from the crust is its own foot; its pair lies along the
-        // input's normal there.
-        stray.extend(sample_distance.iter().enumerate().filter(|(_, &d)| d > threshold).map(|(i, &d)| Stray {
-            distance: d,
-            foot: samples.points[i],
-            direction: samples.normals[i],
-            triangle: samples.triangles[i],
-            at_input: true,
-        }));
+        let mut stray = strays(&far, &crust.mesh.positions, &sample_distance, &samples, mesh, threshold);
         if round == rounds || stray.is_empty() || budget < 2 || stale || report.gated {
             break;
         }
-        stray.sort_by(|a, b| {
-            b.distance.total_cmp(&a.distance).then(a.foot.map(f64::to_bits).cmp(&b.foot.map(f64::to_bits)))
-        });
-        let mut feet: Vec<[f64; 3]> = Vec::new();
-        let mut new: Vec<[f64; 3]> = Vec::new();
-        // Whether each of `new` came from an input sample's pair.
-        let mut from_input: Vec<bool> = Vec::new();
         // A round takes at most ROUND_SHARE of the budget left, so that the rounds after it
         // can cut what it exposes.
         let round_budget = ((ROUND_SHARE * budget as f64).ceil() as usize).clamp(2, budget);
-        for st in &stray {
-            if new.len() + 2 > round_budget {
-                break;
-            }
-            let c = st.foot;
-            if feet.iter().any(|f| dist2(*f, c) < 4.0 * tolerance * tolerance) {
-                continue;
-            }
-            // A crust vertex whose foot is on the rim of a hole in the input spans the hole
-            // (the solid closes it); no site pair there can bring it nearer, and pairs along
-            // its direction would lie in the hole's plane. Measured on the scanned bunny
-            // (holes underneath): carving there lowered F-score 0.990 → 0.978.
-            if on_open_edge(mesh, st.triangle as usize, c, &open_edges, 1e-9) {
-                continue;
-            }
-            feet.push(c);
-            let n = st.direction;
-            new.extend([1.0, -1.0].map(|s| [0, 1, 2].map(|i| (c[i] + s * tolerance * n[i]).clamp(1e-6, 1.0 - 1e-6))));
-            from_input.extend([st.at_input; 2]);
-        }
+        let (feet, mut new, from_input) = pairs_at(&mut stray, mesh, &open_edges, tolerance, round_budget);
         // A pair at an edge is turned to bisect it ([`aim_at_edges`]). A site still nearer
         // the input than half its offset stands by another part of the surface than its
         // foot's: at a corner, or across a thin part. Its cell, bounded on that side only by
@@ -312,7 +209,7 @@ pub const MIN_CLEARANCE: f64 = 0.5;
 /// [`MIN_CLEARANCE`]·`tolerance` away from, in their order.
 ///
 /// # Errors
-/// [`FitError::Failure`] for a non-finite site.
+/// [`FitError::Occupancy`] for a non-finite site.
 pub fn clear_of_the_input(oracle: &MeshOracle, new: Vec<[f64; 3]>, tolerance: f64) -> Result<Vec<[f64; 3]>, FitError> {
     let clear = clearance_mask(oracle, &new, tolerance)?;
     Ok(new.into_iter().zip(&clear).filter(|(_, &c)| c).map(|(p, _)| p).collect())
@@ -335,7 +232,7 @@ fn clearance_mask(oracle: &MeshOracle, new: &[[f64; 3]], tolerance: f64) -> Resu
 /// site at a concave one poked through the thin wall behind it.
 ///
 /// # Errors
-/// [`FitError::Failure`] for a non-finite site.
+/// [`FitError::Occupancy`] for a non-finite site.
 fn aim_at_edges(
     oracle: &MeshOracle,
     mesh: &TriMesh,
@@ -421,7 +318,7 @@ fn mirror_closure(
             if c.1 != inside
                 || !clear
                 || new.len() + next.len() >= budget
-                || new.iter().chain(next.iter().map(|n| &n.0)).any(|x| dist2(*x, c.0) < dup2)
+                || new.iter().chain(next.iter().map(|n| &n.0)).any(|x| distance_squared(*x, c.0) < dup2)
             {
                 continue;
             }
@@ -454,11 +351,6 @@ pub const CLOSURE_DEPTH: usize = 3;
 /// Sample normals with a cosine above this are one face to [`mirror_closure`] (about 18°).
 const FACE_COSINE: f64 = 0.95;
 
-/// (`occupancy`'s vector helpers are private to it.)
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// Rounds in a row that do not beat the best state before [`carve`] stops early. Measured
 /// on the 16 meshes of the quality benchmark at K = 8,192: where a round improved on the
 /// best, it came at most two rounds after the previous improvement (thin_plate, box_fin,
@@ -490,6 +382,88 @@ struct Stray {
     triangle: u32,
     /// Whether the foot is an input sample far from the crust.
     at_input: bool,
+}
+
+/// Where the error is: the crust vertices at `positions` farther than `threshold` from the
+/// input (`far`: their closest input points) and the input `samples` farther than it from
+/// the crust (`sample_distance`), each with the foot and the direction of its pair.
+fn strays(
+    far: &[occupancy::ClosestPoint],
+    positions: &[[f64; 3]],
+    sample_distance: &[f64],
+    samples: &InputSamples,
+    mesh: &TriMesh,
+    threshold: f64,
+) -> Vec<Stray> {
+    let mut stray: Vec<Stray> = far
+        .iter()
+        .zip(positions)
+        .filter(|(c, _)| c.squared_distance.sqrt() > threshold)
+        .map(|(c, &v)| {
+            let d = c.squared_distance.sqrt();
+            // The pair lies along the stray vertex's own direction from its foot.
+            // Where the foot is inside a triangle that is the triangle's normal; at an
+            // edge or a corner (a spike off a plate's rim, a CAD part's corner) it is
+            // the direction the spike actually takes, which a neighbouring face's
+            // normal is not.
+            let direction = if d > 0.0 {
+                [0, 1, 2].map(|i| (v[i] - c.point[i]) / d)
+            } else {
+                soft_voronoi::solid::unit_normal(mesh, c.triangle as usize)
+            };
+            Stray { distance: d, foot: c.point, direction, triangle: c.triangle, at_input: false }
+        })
+        .collect();
+    // An input sample far from the crust is its own foot; its pair lies along the
+    // input's normal there.
+    stray.extend(sample_distance.iter().enumerate().filter(|(_, &d)| d > threshold).map(|(i, &d)| Stray {
+        distance: d,
+        foot: samples.points[i],
+        direction: samples.normals[i],
+        triangle: samples.triangles[i],
+        at_input: true,
+    }));
+    stray
+}
+
+/// The pairs of one round, farthest stray first, at most `round_budget` sites: feet closer
+/// than two tolerances to an earlier one, and feet on an open edge, are skipped. Returns
+/// the feet, the pairs' sites and whether each came from an input sample.
+fn pairs_at(
+    stray: &mut [Stray],
+    mesh: &TriMesh,
+    open_edges: &[(u32, u32)],
+    tolerance: f64,
+    round_budget: usize,
+) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, Vec<bool>) {
+    stray.sort_by(|a, b| {
+        b.distance.total_cmp(&a.distance).then(a.foot.map(f64::to_bits).cmp(&b.foot.map(f64::to_bits)))
+    });
+    let mut feet: Vec<[f64; 3]> = Vec::new();
+    let mut new: Vec<[f64; 3]> = Vec::new();
+    // Whether each of `new` came from an input sample's pair.
+    let mut from_input: Vec<bool> = Vec::new();
+    for st in stray.iter() {
+        if new.len() + 2 > round_budget {
+            break;
+        }
+        let c = st.foot;
+        if feet.iter().any(|f| distance_squared(*f, c) < 4.0 * tolerance * tolerance) {
+            continue;
+        }
+        // A crust vertex whose foot is on the rim of a hole in the input spans the hole
+        // (the solid closes it); no site pair there can bring it nearer, and pairs along
+        // its direction would lie in the hole's plane. Measured on the scanned bunny
+        // (holes underneath): carving there lowered F-score 0.990 → 0.978.
+        if on_open_edge(mesh, st.triangle as usize, c, open_edges, 1e-9) {
+            continue;
+        }
+        feet.push(c);
+        let n = st.direction;
+        new.extend([1.0, -1.0].map(|s| [0, 1, 2].map(|i| (c[i] + s * tolerance * n[i]).clamp(1e-6, 1.0 - 1e-6))));
+        from_input.extend([st.at_input; 2]);
+    }
+    (feet, new, from_input)
 }
 
 /// The crust after one round of [`carve`].
@@ -601,9 +575,14 @@ fn distances_to(points: &[[f64; 3]], target: &metrics::DistanceMesh) -> Vec<f64>
 /// Samples of the input for [`InputSamples`].
 const INPUT_SAMPLES: usize = 100_000;
 
-/// A failed query while carving, as the fit's error.
-fn failure(e: impl std::fmt::Display) -> FitError {
-    FitError::Failure(format!("carving: {e}"))
+/// A failed occupancy query while carving, as the fit's error.
+fn failure(source: occupancy::OccupancyError) -> FitError {
+    FitError::Occupancy { during: "carving", source }
+}
+
+/// A failed distance measurement while carving, as the fit's error.
+fn measure_failure(source: metrics::MetricsError) -> FitError {
+    FitError::Metrics { during: "carving", source }
 }
 
 /// Whether `c` (a point of triangle `t`) lies within `eps` of one of `t`'s edges that is in
@@ -620,12 +599,8 @@ fn on_open_edge(mesh: &TriMesh, t: usize, c: [f64; 3], open: &[(u32, u32)], eps:
         let w = [0, 1, 2].map(|i| c[i] - pa[i]);
         let ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
         let s = if ee > 0.0 { ((w[0] * e[0] + w[1] * e[1] + w[2] * e[2]) / ee).clamp(0.0, 1.0) } else { 0.0 };
-        dist2(c, [0, 1, 2].map(|i| pa[i] + s * e[i])) <= eps * eps
+        distance_squared(c, [0, 1, 2].map(|i| pa[i] + s * e[i])) <= eps * eps
     })
-}
-
-fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
 }
 
 #[cfg(test)]

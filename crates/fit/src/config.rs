@@ -141,15 +141,15 @@ pub struct FitConfig {
     /// is given.
     pub train_shell: bool,
     /// Start from pairs refined where a previous fit's crust missed a tolerance (the
-    /// accuracy target's rounds, [`crate::grow`]); only with [`soft_voronoi::Init::Pairs`]
+    /// accuracy target's rounds, `grow`); only with [`soft_voronoi::Init::Pairs`]
     /// on the winding-number solid.
-    pub refine: Option<crate::grow::Refine>,
+    pub refine: Option<Refine>,
     /// After training, give every trainable site the solid's label where it stands (see
     /// the report's `relabelled_sites`). Default on; `--no-relabel` keeps the training
     /// labels.
     pub relabel: bool,
     /// Insert sites where the crust's vertices are farther than this share of the diagonal
-    /// from the input ([`crate::carve`]; default 0.3%, up to K/8 sites in eight rounds);
+    /// from the input (the `carve` stage; default 0.3%, up to K/8 sites in eight rounds);
     /// `None`: off.
     pub carve: Option<f64>,
     /// Last, remove the sites that change neither the crust nor the nearest-site occupancy
@@ -221,24 +221,32 @@ impl FitConfig {
     /// evaluation settings of `self` (the checkpoint does not hold them).
     ///
     /// # Errors
-    /// [`FitError::Input`] when the file is not a checkpoint of the main job.
+    /// [`FitError::CheckpointRead`] when the file cannot be read as a checkpoint,
+    /// [`FitError::CheckpointSettings`] when it is not a checkpoint of the main job.
     pub fn resume(mut self, path: &Path) -> Result<Self, FitError> {
-        let (state, context) = checkpoint::read(path).map_err(|e| FitError::Input(e.to_string()))?;
-        let sampling: Sampling = serde_json::from_str(&context).map_err(|e| {
-            FitError::Input(format!("{}: not a checkpoint of `voronoi-fit MESH` ({e})", path.display()))
+        let (state, context) =
+            checkpoint::read(path).map_err(|source| FitError::CheckpointRead { path: path.to_path_buf(), source })?;
+        let sampling: Sampling = serde_json::from_str(&context).map_err(|source| FitError::CheckpointSettings {
+            path: path.to_path_buf(),
+            what: "not a checkpoint of `voronoi-fit MESH`",
+            source,
         })?;
         // The polish settings of the run that wrote the checkpoint (checkpoints written
         // before the polish existed have none: the current settings stay).
         if let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(&context) {
             if let Some(p) = map.get("polish") {
-                self.polish = serde_json::from_value(p.clone()).map_err(|e| {
-                    FitError::Input(format!("{}: the checkpoint's polish settings: {e}", path.display()))
+                self.polish = serde_json::from_value(p.clone()).map_err(|source| FitError::CheckpointSettings {
+                    path: path.to_path_buf(),
+                    what: "the checkpoint's polish settings",
+                    source,
                 })?;
                 // The choice of the aligned polish came later: a checkpoint without it was
                 // written by a run that polished once.
                 self.try_alignment = match map.get("try_alignment") {
-                    Some(a) => serde_json::from_value(a.clone()).map_err(|e| {
-                        FitError::Input(format!("{}: the checkpoint's alignment settings: {e}", path.display()))
+                    Some(a) => serde_json::from_value(a.clone()).map_err(|source| FitError::CheckpointSettings {
+                        path: path.to_path_buf(),
+                        what: "the checkpoint's alignment settings",
+                        source,
                     })?,
                     None => None,
                 };
@@ -256,9 +264,9 @@ impl FitConfig {
     /// resume continues exactly the run that was stopped.
     ///
     /// # Errors
-    /// [`FitError::Failure`] when serialisation fails.
+    /// [`FitError::CheckpointContext`] when serialisation fails.
     pub fn checkpoint_context(&self) -> Result<String, FitError> {
-        let fail = |e: serde_json::Error| FitError::Failure(format!("checkpoint settings: {e}"));
+        let fail = FitError::CheckpointContext;
         let mut v = serde_json::to_value(&self.sampling).map_err(fail)?;
         if let serde_json::Value::Object(map) = &mut v {
             map.insert("polish".into(), serde_json::to_value(&self.polish).map_err(fail)?);
@@ -270,35 +278,46 @@ impl FitConfig {
     /// Checks the settings.
     ///
     /// # Errors
-    /// [`FitError::Input`] naming the setting and its accepted range.
+    /// [`FitError::Settings`] or [`FitError::TrainSettings`] naming the setting and its accepted
+    /// range.
     pub fn validate(&self) -> Result<(), FitError> {
-        self.train.validate().map_err(|e| FitError::Input(format!("{e}; see voronoi-fit --help")))?;
+        self.train.validate().map_err(FitError::TrainSettings)?;
         let s = &self.sampling;
         if self.resume.is_none() && (!(1000..=100_000_000).contains(&s.samples) || self.train.num_sites > s.samples / 2)
         {
-            return Err(FitError::Input(format!(
+            return Err(FitError::Settings(format!(
                 "--samples {} must be in 1000..=100000000 and at least twice --sites {}",
                 s.samples, self.train.num_sites
             )));
         }
         if let Some(p) = &self.polish {
-            p.validate().map_err(|e| FitError::Input(format!("{e}; see voronoi-fit --help")))?;
+            p.validate().map_err(FitError::TrainSettings)?;
         }
         if self.eval.samples > 100_000_000 {
-            return Err(FitError::Input(format!("--eval-samples {} must be at most 100000000", self.eval.samples)));
+            return Err(FitError::Settings(format!("--eval-samples {} must be at most 100000000", self.eval.samples)));
         }
         let good = |v: &[f64]| !v.is_empty() && v.iter().all(|x| x.is_finite() && *x > 0.0 && *x < 1.0);
         if !good(&s.sigmas) || !good(&self.eval.sigmas) {
-            return Err(FitError::Input("near-surface spreads must be in (0, 1) of the diagonal".into()));
+            return Err(FitError::Settings("near-surface spreads must be in (0, 1) of the diagonal".into()));
         }
         if let Some(t) = s.shell_thickness {
             if !(t.is_finite() && t > 0.0 && t <= 0.2) {
-                return Err(FitError::Input(format!("--shell-thickness {t} must be in (0, 0.2] of the diagonal")));
+                return Err(FitError::Settings(format!("--shell-thickness {t} must be in (0, 0.2] of the diagonal")));
             }
         }
         if !(s.margin.is_finite() && s.margin >= 0.0 && s.margin < 0.5) {
-            return Err(FitError::Input(format!("margin {} must be in [0, 0.5)", s.margin)));
+            return Err(FitError::Settings(format!("margin {} must be in [0, 0.5)", s.margin)));
         }
         Ok(())
     }
+}
+
+/// What to refine: the crust of a previous fit of the same mesh and the distance it should
+/// have kept to the input.
+#[derive(Clone, Debug)]
+pub struct Refine {
+    /// The previous crust, in the input's frame.
+    pub previous: mesh_io::TriMesh,
+    /// The target distance, input units.
+    pub tolerance: f64,
 }

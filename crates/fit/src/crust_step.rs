@@ -31,8 +31,8 @@ impl CheckedCrust {
 /// f64 cannot tell apart (mirrored pairs make many); no site is moved.
 ///
 /// # Errors
-/// [`FitError::Failure`] when the crust cannot be extracted; [`FitError::Input`] when the
-/// rounded output cannot be made valid (coordinates beyond float32, for example).
+/// [`FitError::Crust`] when the crust cannot be extracted; [`FitError::OutputPrecision`]
+/// when the rounded output cannot be made valid (coordinates beyond float32, for example).
 pub fn crust_of(
     sites: &[[f64; 3]],
     labels: &[bool],
@@ -40,10 +40,10 @@ pub fn crust_of(
     precision: Precision,
 ) -> Result<CheckedCrust, FitError> {
     let crust = Crust::extract(sites, labels, &CrustConfig::default())
-        .map_err(|e| FitError::Failure(format!("crust of the trained sites: {e}")))?;
+        .map_err(|source| FitError::Crust { during: "crust of the trained sites", source })?;
     let written = finalize(&crust, map, precision).map_err(|e| match e {
-        crust::CrustError::Internal(_) => FitError::Failure(format!("the crust as written: {e}")),
-        e => FitError::Input(format!("the crust as written: {e}")),
+        crust::CrustError::Internal(_) => FitError::Crust { during: "the crust as written", source: e },
+        e => FitError::OutputPrecision(e),
     })?;
     Ok(CheckedCrust { crust, written })
 }

@@ -36,7 +36,7 @@ pub fn compact(mesh: &TriMesh) -> TriMesh {
 /// the pool and the number of uniform points (they come first).
 ///
 /// # Errors
-/// [`FitError::Failure`] from the samplers (invalid sizes).
+/// [`FitError::Occupancy`] from the samplers (invalid sizes).
 pub fn labelled_samples(
     sampler: &SurfaceSampler,
     solid: &dyn Solid,
@@ -44,7 +44,7 @@ pub fn labelled_samples(
     sigmas: &[f64],
     seed: u64,
 ) -> Result<(TrainingData, usize), FitError> {
-    let fail = |e: occupancy::OccupancyError| FitError::Failure(format!("sampling: {e}"));
+    let fail = |source| FitError::Occupancy { during: "sampling", source };
     let mut points = uniform_in_box([0.0; 3], [1.0; 3], n / 2, seed).map_err(fail)?;
     let num_uniform = points.len();
     points.extend(near_surface(sampler, n - n / 2, sigmas, seed).map_err(fail)?);

@@ -24,46 +24,9 @@
 //! protruding part as the next crust.
 
 use crust::{Crust, CrustConfig};
-use serde::Serialize;
 
 use crate::error::FitError;
-
-/// What [`guard`] did (report field `guard`).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct GuardReport {
-    /// The input's bounding box in unit-cube coordinates (the planes mirrored across).
-    pub box_lo: [f64; 3],
-    /// Upper corner of the box.
-    pub box_hi: [f64; 3],
-    /// Crust vertices farther than this beyond the box trigger mirrors (the carving
-    /// tolerance), unit-cube lengths.
-    pub threshold: f64,
-    /// Mirror sites added, per round (before carving).
-    pub inserted_per_round: Vec<usize>,
-    /// Mirror sites added per round when the guard ran again after carving's kept rounds
-    /// (empty when carving kept none).
-    pub inserted_after_carving: Vec<usize>,
-    /// Mirrors that would have left the unit cube (not added).
-    pub skipped_outside_cube: usize,
-    /// How far the crust reached beyond the box before and after, unit-cube lengths.
-    pub beyond_before: f64,
-    /// After the last round.
-    pub beyond_after: f64,
-}
-
-impl GuardReport {
-    /// Takes in the report of the guard's second pass, after carving.
-    pub fn after_carving(&mut self, again: GuardReport) {
-        self.inserted_after_carving = again.inserted_per_round;
-        self.skipped_outside_cube += again.skipped_outside_cube;
-        self.beyond_after = again.beyond_after;
-    }
-
-    /// Mirror sites added in both passes.
-    pub fn inserted(&self) -> usize {
-        self.inserted_per_round.iter().chain(&self.inserted_after_carving).sum()
-    }
-}
+pub use crate::report::GuardReport;
 
 /// Rounds of [`guard`] at most.
 pub const GUARD_ROUNDS: usize = 4;
@@ -73,7 +36,7 @@ pub const GUARD_ROUNDS: usize = 4;
 /// to [`GUARD_ROUNDS`] rounds. Only inside sites within the box are mirrored.
 ///
 /// # Errors
-/// [`FitError::Failure`] when a crust cannot be extracted.
+/// [`FitError::Crust`] when a crust cannot be extracted.
 pub fn guard(
     sites: &mut Vec<[f64; 3]>,
     labels: &mut Vec<bool>,
@@ -86,7 +49,7 @@ pub fn guard(
     let mut existing: std::collections::HashSet<[u64; 3]> = sites.iter().map(|p| p.map(f64::to_bits)).collect();
     for round in 0..=GUARD_ROUNDS {
         let crust = Crust::extract(sites, labels, &CrustConfig::default())
-            .map_err(|e| FitError::Failure(format!("guarding the box: {e}")))?;
+            .map_err(|source| FitError::Crust { during: "guarding the box", source })?;
         let far: Vec<[f64; 3]> = crust.mesh.positions.iter().copied().filter(|&v| beyond(v) > threshold).collect();
         let reach = crust.mesh.positions.iter().fold(0.0f64, |m, &v| m.max(beyond(v)));
         if round == 0 {

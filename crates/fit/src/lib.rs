@@ -31,6 +31,7 @@ pub mod grow;
 pub mod guard;
 pub mod options;
 pub mod progress;
+mod refine;
 pub mod report;
 mod run;
 pub mod target;
@@ -40,7 +41,7 @@ pub use config::{
     MARGIN, TRY_ALIGNMENT_WEIGHT,
 };
 pub use crust_step::{crust_of, CheckedCrust};
-pub use error::FitError;
+pub use error::{FitError, MeshFault};
 pub use grow::{fit_to_accuracy, AccuracyGoal};
 pub use options::FitOptions;
 pub use progress::{NoProgress, Progress, Stage};

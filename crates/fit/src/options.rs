@@ -79,13 +79,13 @@ impl FitOptions {
     /// The validated settings for a mesh called `name` (used in messages and the report).
     ///
     /// # Errors
-    /// [`FitError::Input`] naming the bad option.
+    /// [`FitError::Settings`] or [`FitError::TrainSettings`] naming the bad option.
     pub fn to_config(&self, name: &str) -> Result<FitConfig, FitError> {
         let preset = self.preset.as_deref().unwrap_or("default");
         let paper = match preset {
             "default" => false,
             "paper" => true,
-            other => return Err(FitError::Input(format!("preset `{other}`: use `default` or `paper`"))),
+            other => return Err(FitError::Settings(format!("preset `{other}`: use `default` or `paper`"))),
         };
         let mut c = FitConfig::new(name, self.sites.unwrap_or(DEFAULT_SITES));
         c.sampling.samples = self.samples.unwrap_or(c.sampling.samples);
@@ -130,7 +130,7 @@ impl FitOptions {
             (p.steps > 0).then_some(p)
         };
         if c.polish.is_some() && self.no_relabel {
-            return Err(FitError::Input(
+            return Err(FitError::Settings(
                 "--no-relabel needs --no-polish: the polish moves sites without looking at their labels, so after it \
                  every site takes the solid's label where it stands"
                     .into(),

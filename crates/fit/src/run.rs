@@ -13,7 +13,7 @@ use crate::carve::SurfaceBar;
 use crate::config::FitConfig;
 use crate::crust_step::{crust_of, CheckedCrust};
 use crate::data::{compact, labelled_samples};
-use crate::error::FitError;
+use crate::error::{FitError, MeshFault};
 use crate::progress::{Progress, Stage};
 use crate::report::*;
 use crate::target;
@@ -45,11 +45,10 @@ fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
     let name = &config.sampling.mesh;
     let mesh = compact(input);
     if mesh.triangles.is_empty() {
-        return Err(FitError::Input(format!("{name}: the mesh has no triangles; nothing to fit")));
+        return Err(FitError::Mesh { mesh: name.clone(), fault: MeshFault::NoTriangles });
     }
-    let transform = UnitCubeTransform::of_mesh(&mesh, config.sampling.margin).ok_or_else(|| {
-        FitError::Input(format!("{name}: the mesh has no extent (all vertices coincide) or non-finite coordinates"))
-    })?;
+    let transform = UnitCubeTransform::of_mesh(&mesh, config.sampling.margin)
+        .ok_or_else(|| FitError::Mesh { mesh: name.clone(), fault: MeshFault::NoExtent })?;
     // The solid, the samples' normals and the carving use a copy whose pieces agree on
     // their orientation (triangles flipped against their neighbours turn part of a body
     // inside out for the winding number); the input itself, and the metrics against it,
@@ -127,13 +126,19 @@ fn choose_alignment(
     }
 }
 
-/// Stage timer.
-struct Lap {
+/// Stage timer: the time since the last lap, and the report's per-stage timings.
+struct Clock {
     t: Instant,
+    timings: Timings,
 }
 
-impl Lap {
-    fn next(&mut self) -> f64 {
+impl Clock {
+    fn new() -> Self {
+        Clock { t: Instant::now(), timings: Timings::default() }
+    }
+
+    /// Seconds since the last lap.
+    fn lap(&mut self) -> f64 {
         let s = self.t.elapsed().as_secs_f64();
         self.t = Instant::now();
         s
@@ -149,33 +154,25 @@ impl Lap {
 ///   vertices are ignored.
 ///
 /// # Errors
-/// [`FitError::Input`] for unusable meshes (no triangles, no extent, no area, nothing
-/// inside) and settings; [`FitError::Interrupted`] when `progress` asked to stop (after the
-/// checkpoint is written); [`FitError::Failure`] otherwise.
+/// [`FitError::Mesh`] for unusable meshes (no triangles, no extent, no area, nothing
+/// inside), [`FitError::Settings`] and the like for settings (all with
+/// [`FitError::is_input_fault`]); [`FitError::Interrupted`] when `progress` asked to stop
+/// (after the checkpoint is written); another variant for what failed otherwise.
 pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
     let t_all = Instant::now();
     config.validate()?;
-    let name = &config.sampling.mesh;
-    let mut lap = Lap { t: Instant::now() };
-    let mut timings = Timings::default();
+    let mut clock = Clock::new();
 
     progress.stage(Stage::Load);
     let p = prepare(input, config)?;
-    timings.load = lap.next();
+    clock.timings.load = clock.lap();
     progress.stage(Stage::Oracle);
-    let oracle = MeshOracle::from_mesh(&p.unit, &occupancy::Config::default())
-        .map_err(|e| FitError::Input(format!("{name}: {e}")))?;
-    let sampler = SurfaceSampler::from_mesh(&p.unit)
-        .map_err(|e| FitError::Input(format!("{name}: {e} (the mesh has no area to sample)")))?;
-    let winding = MeshSolid { oracle: &oracle };
-    timings.oracle = lap.next();
+    let (oracle, sampler) = oracle_and_sampler(&p.unit, &config.sampling.mesh)?;
+    clock.timings.oracle = clock.lap();
 
     progress.stage(Stage::Sample);
     let diagonal = p.unit.diagonal();
-    let s = &config.sampling;
-    let train_sigmas: Vec<f64> = s.sigmas.iter().map(|x| x * diagonal).collect();
-    let (mut data, num_uniform) = labelled_samples(&sampler, &winding, s.samples, &train_sigmas, s.seed)?;
-    let scale = p.transform.scale;
+    let (mut data, num_uniform, train_sigmas) = training_pool(&sampler, &oracle, config, diagonal)?;
     let (target, solid_report) = target::choose(
         &oracle,
         &p.unit,
@@ -184,11 +181,11 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         num_uniform,
         config,
         diagonal,
-        scale,
+        p.transform.scale,
         p.topology.is_closed,
     )?;
-    let solid = target.solid();
-    timings.sample = lap.next();
+    clock.timings.sample = clock.lap();
+    // A thin shell's sites are kept as constructed unless asked for (`train_shell`).
     let untrained;
     let config = if target.places_sites() && !config.train_shell {
         untrained =
@@ -199,58 +196,303 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     };
 
     progress.stage(Stage::Train);
-    let mut refined_share = None;
-    let initial = match (target.initial_sites(), &config.refine) {
-        (Some(initial), _) => Some(initial),
+    let (initial, refined_share) = initial_sites(&target, config, &p, &oracle, &sampler, &data)?;
+    let trainer = train(&data, target.solid(), initial, config, progress)?;
+    clock.timings.train = clock.lap();
+
+    let after = AfterTraining {
+        config,
+        p: &p,
+        oracle: &oracle,
+        data: &data,
+        target: &target,
+        trainer: &trainer,
+        cap_samples: solid_report.cap_samples,
+        diagonal,
+    };
+    let (chosen, measured, polish_choice) = after.polish_and_crust(progress, &mut clock)?;
+    let crust_mesh = chosen.checked.written.mesh.clone();
+    clock.timings.crust += clock.lap();
+
+    progress.stage(Stage::Evaluate);
+    let quality = misclassification(&sampler, target.solid(), &chosen.sites, &chosen.labels, config, diagonal)?;
+    clock.timings.evaluate = clock.lap();
+
+    progress.stage(Stage::Metrics);
+    let metrics = match measured {
+        _ if config.skip_metrics => MetricsReport::Skipped { skipped: "not asked for".into() },
+        Some(m) => m,
+        None => after.measure(&crust_mesh),
+    };
+    clock.timings.metrics += clock.lap();
+
+    let state = trainer.state().clone();
+    let Attempt { sites, labels, num_projected, polish, num_relabelled, guard, carving, pruning, checked } = chosen;
+    let report = FitReport {
+        format_version: 1,
+        input: input_report(input, &config.sampling.mesh, &p),
+        settings: settings_report(&state, config, train_sigmas),
+        solid: solid_report,
+        transform: TransformReport { center: p.transform.center, scale: p.transform.scale },
+        timings_seconds: clock.timings,
+        losses: LossesReport::of(&state),
+        quality,
+        metrics,
+        crust: crust_report(&checked, &crust_mesh, num_projected),
+        refined_share,
+        polish,
+        polish_choice,
+        relabelled_sites: config.relabel.then_some(num_relabelled),
+        carving,
+        guard,
+        pruning,
+        accuracy_target: None,
+        outputs: OutputsReport::default(),
+        total_seconds: t_all.elapsed().as_secs_f64(),
+    };
+    let sites = SitesFile { sites, inside: labels, transform: p.transform.from_unit_matrix() };
+    Ok(FitOutput { sites, crust: crust_mesh, state, report })
+}
+
+/// The occupancy oracle and the surface sampler of the mesh in the unit cube (`name` for
+/// messages).
+fn oracle_and_sampler(unit: &TriMesh, name: &str) -> Result<(MeshOracle, SurfaceSampler), FitError> {
+    let oracle = MeshOracle::from_mesh(unit, &occupancy::Config::default())
+        .map_err(|e| FitError::Mesh { mesh: name.to_string(), fault: MeshFault::Oracle(e) })?;
+    let sampler = SurfaceSampler::from_mesh(unit)
+        .map_err(|e| FitError::Mesh { mesh: name.to_string(), fault: MeshFault::NoArea(e) })?;
+    Ok((oracle, sampler))
+}
+
+/// The training pool labelled by the winding-number solid, where its near-surface part
+/// starts, and its spreads in unit-cube lengths.
+fn training_pool(
+    sampler: &SurfaceSampler,
+    oracle: &MeshOracle,
+    config: &FitConfig,
+    diagonal: f64,
+) -> Result<(TrainingData, usize, Vec<f64>), FitError> {
+    let s = &config.sampling;
+    let winding = MeshSolid { oracle };
+    let train_sigmas: Vec<f64> = s.sigmas.iter().map(|x| x * diagonal).collect();
+    let (data, num_uniform) = labelled_samples(sampler, &winding, s.samples, &train_sigmas, s.seed)?;
+    Ok((data, num_uniform, train_sigmas))
+}
+
+/// The sites training starts from when not `config.train.init`'s: the thin shell's own, or
+/// pairs refined where a previous crust missed (the accuracy target's rounds), with the
+/// share of candidates refined.
+type InitialSites = (Option<(Vec<[f64; 3]>, Vec<bool>)>, Option<f64>);
+
+/// See [`InitialSites`].
+fn initial_sites(
+    target: &target::Target,
+    config: &FitConfig,
+    p: &Prepared,
+    oracle: &MeshOracle,
+    sampler: &SurfaceSampler,
+    data: &TrainingData,
+) -> Result<InitialSites, FitError> {
+    Ok(match (target.initial_sites(), &config.refine) {
+        (Some(initial), _) => (Some(initial), None),
         (None, Some(r)) if config.train.init == soft_voronoi::Init::Pairs && config.resume.is_none() => {
             let area = sampler.total_area();
             let (sites, labels, share) =
-                crate::grow::refined_pairs(r, &p.transform, &oracle, area, &data, solid, config)?;
-            refined_share = Some(share);
-            Some((sites, labels))
+                crate::refine::refined_pairs(r, &p.transform, oracle, area, data, target.solid(), config)?;
+            (Some((sites, labels)), Some(share))
         }
-        _ => None,
-    };
-    let trainer = train(&data, solid, initial, config, progress)?;
-    timings.train = lap.next();
+        _ => (None, None),
+    })
+}
 
-    // Everything from the polish on, with or without the polish's alignment term.
-    // `gate`: carving stops before its first round, and the attempt ends with the uncarved
-    // crust's Chamfer distance and normal consistency (`Ok(Err(_))`), when that crust does not
-    // reach them.
-    let attempt = |aligned: bool,
-                   gate: Option<SurfaceBar>,
-                   progress: &mut dyn Progress,
-                   timings: &mut Timings,
-                   lap: &mut Lap|
-     -> Result<Result<Attempt, SurfaceBar>, FitError> {
+/// What the stages after training share: the trained sites and everything they were
+/// trained on.
+struct AfterTraining<'a> {
+    config: &'a FitConfig,
+    p: &'a Prepared,
+    oracle: &'a MeshOracle,
+    data: &'a TrainingData,
+    target: &'a target::Target<'a>,
+    trainer: &'a Trainer<'a>,
+    /// Surface samples on the winding solid's caps (at the end of `data.surface`).
+    cap_samples: usize,
+    diagonal: f64,
+}
+
+impl AfterTraining<'_> {
+    /// The metrics of a crust against the input (the crust was checked when it was built,
+    /// so its validity is not recomputed).
+    fn measure(&self, crust: &TriMesh) -> MetricsReport {
+        let opts = metrics::EvalOptions { skip_validity: true, ..Default::default() };
+        match metrics::evaluate(&self.p.mesh, crust, &opts) {
+            Ok(m) => MetricsReport::Done(Box::new(m)),
+            Err(e) => MetricsReport::Failed { error: e.to_string() },
+        }
+    }
+
+    /// Everything from the polish on, once or twice: returns the attempt kept, its metrics
+    /// when the choice measured them, and the choice.
+    ///
+    /// The polish's alignment term lines pairs up, and lined-up pairs are nearly
+    /// cospherical: their crust has Voronoi vertices that nearly coincide. Should the crust
+    /// then not survive rounding to the output's precision, everything from the polish on
+    /// runs again without the term (the report's `polish.alignment_dropped`). Asked for with
+    /// `--polish-align W`; by default on a closed input both crusts are built and the
+    /// aligned one is kept only where it is at least as good on all four metrics against
+    /// the input ([`choose_alignment`]).
+    fn polish_and_crust(
+        &self,
+        progress: &mut dyn Progress,
+        clock: &mut Clock,
+    ) -> Result<(Attempt, Option<MetricsReport>, Option<PolishChoice>), FitError> {
+        let config = self.config;
+        let forced = config.polish.as_ref().is_some_and(|pc| pc.alignment.is_some());
+        let tries = config.try_alignment.is_some()
+            && !forced
+            && config.polish.is_some()
+            && !self.target.places_sites()
+            && self.p.topology.is_closed;
+        // No gate is passed here, so every attempt below ends with a crust.
+        let done = |a: Result<Attempt, SurfaceBar>| a.map_err(|_| FitError::Internal("carving stopped without a gate"));
+        let plain = if forced {
+            match self.attempt(true, None, progress, clock) {
+                Err(e) if e.is_input_fault() => {
+                    let mut a = done(self.attempt(false, None, progress, clock)?)?;
+                    if let Some(pr) = a.polish.as_mut() {
+                        pr.alignment_dropped = Some(e.to_string());
+                    }
+                    a
+                }
+                other => done(other?)?,
+            }
+        } else {
+            done(self.attempt(false, None, progress, clock)?)?
+        };
+        if tries {
+            self.try_aligned(plain, progress, clock)
+        } else {
+            Ok((plain, None, None))
+        }
+    }
+
+    /// The default's second attempt on a closed input, with the alignment term, and the
+    /// choice between it and `plain` ([`choose_alignment`]).
+    fn try_aligned(
+        &self,
+        plain: Attempt,
+        progress: &mut dyn Progress,
+        clock: &mut Clock,
+    ) -> Result<(Attempt, Option<MetricsReport>, Option<PolishChoice>), FitError> {
+        let t_choice = Instant::now();
+        progress.stage(Stage::Metrics);
+        let plain_metrics = self.measure(&plain.checked.written.mesh);
+        clock.timings.metrics += clock.lap();
+        // Carving hardly moves a crust's Chamfer distance and normal consistency (it works
+        // where the Hausdorff distance is set), and the choice below asks for both to be no
+        // worse: an aligned crust that falls short of the plain one's on either before
+        // carving stops there, which spares its carving (on the Menger sponge, 7 of 8 rounds'
+        // worth of seconds).
+        let gate = plain.carving.as_ref().map(|r| r.first_surface);
+        let (aligned, aligned_error, stopped) = match self.attempt(true, gate, progress, clock) {
+            Ok(Ok(a)) => (Some(a), None, None),
+            Ok(Err(bar)) => (None, None, Some(bar)),
+            Err(e) if e.is_input_fault() => (None, Some(e.to_string()), None),
+            Err(e) => return Err(e),
+        };
+        progress.stage(Stage::Metrics);
+        let aligned_metrics = aligned.as_ref().map(|a| self.measure(&a.checked.written.mesh));
+        clock.timings.metrics += clock.lap();
+        let mut c = choose_alignment(&plain_metrics, aligned_metrics.as_ref(), aligned_error);
+        c.before_carving = stopped.map(|aligned| BeforeCarving { plain: gate.unwrap_or_default(), aligned });
+        let kept = c.aligned_kept;
+        let choice = Some(PolishChoice { seconds: t_choice.elapsed().as_secs_f64(), ..c });
+        match (kept, aligned, aligned_metrics) {
+            (true, Some(a), Some(m)) => Ok((a, Some(m), choice)),
+            _ => Ok((plain, Some(plain_metrics), choice)),
+        }
+    }
+
+    /// Everything from the polish on, with or without the polish's alignment term.
+    /// `gate`: carving stops before its first round, and the attempt ends with the uncarved
+    /// crust's Chamfer distance and normal consistency (`Ok(Err(_))`), when that crust does
+    /// not reach them.
+    fn attempt(
+        &self,
+        aligned: bool,
+        gate: Option<SurfaceBar>,
+        progress: &mut dyn Progress,
+        clock: &mut Clock,
+    ) -> Result<Result<Attempt, SurfaceBar>, FitError> {
+        let config = self.config;
         progress.stage(Stage::Polish);
-        let (mut sites, mut labels, num_projected) = trainer.final_sites();
-        let polish = match &config.polish {
-            Some(pc) if !target.places_sites() => {
+        let (mut sites, mut labels, num_projected) = self.trainer.final_sites();
+        let polish = self.polish(&mut sites, &labels, aligned, progress)?;
+        clock.timings.polish += clock.lap();
+
+        progress.stage(Stage::Crust);
+        let num_relabelled = if config.relabel {
+            relabel(&sites, &mut labels, self.trainer.config().num_sites, self.target.solid())
+        } else {
+            0
+        };
+        let carved = self.carve_and_crust(sites, labels, gate);
+        clock.timings.crust += clock.lap();
+        Ok(carved?.map(|(sites, labels, guard, carving, pruning, checked)| Attempt {
+            sites,
+            labels,
+            num_projected,
+            polish,
+            num_relabelled,
+            guard,
+            carving,
+            pruning,
+            checked,
+        }))
+    }
+
+    /// The polish of one attempt (none on a thin shell, whose sites are placed on the
+    /// shell's sides, not on the sampled surface).
+    fn polish(
+        &self,
+        sites: &mut [[f64; 3]],
+        labels: &[bool],
+        aligned: bool,
+        progress: &mut dyn Progress,
+    ) -> Result<Option<soft_voronoi::PolishReport>, FitError> {
+        let config = self.config;
+        let data = self.data;
+        match &config.polish {
+            Some(pc) if !self.target.places_sites() => {
                 // Cap samples add to each batch instead of taking from the input's share, so the
                 // input's faces are pulled as often as without caps; at most twice the batch,
                 // which bounds the polish's time where the caps outweigh the input (an open
                 // pipe's lids; libigl's halftunnel, caps a third of the crust, takes 1.4 times).
                 let mut pc = pc.clone();
-                let input = data.surface.len().saturating_sub(solid_report.cap_samples).max(1);
+                let input = data.surface.len().saturating_sub(self.cap_samples).max(1);
                 pc.batch = pc.batch * data.surface.len().min(2 * input) / input;
                 pc.alignment =
                     if aligned { pc.alignment.clone().or_else(|| config.try_alignment.clone()) } else { None };
-                Some(polish(&mut sites, &labels, &data, &trainer, &pc, config, progress)?)
+                Ok(Some(polish(sites, labels, data, self.trainer, &pc, config, progress)?))
             }
-            _ => None,
-        };
-        timings.polish += lap.next();
+            _ => Ok(None),
+        }
+    }
 
-        progress.stage(Stage::Crust);
-        let num_relabelled =
-            if config.relabel { relabel(&sites, &mut labels, trainer.config().num_sites, solid) } else { 0 };
+    /// The guard, carving, pruning and the checked crust of relabelled sites; `Ok(Err(_))`
+    /// when carving's `gate` stopped it.
+    fn carve_and_crust(
+        &self,
+        mut sites: Vec<[f64; 3]>,
+        mut labels: Vec<bool>,
+        gate: Option<SurfaceBar>,
+    ) -> Result<Result<Carved, SurfaceBar>, FitError> {
+        let config = self.config;
+        let places_sites = self.target.places_sites();
         // Not on a thin shell kept as constructed: its sides are the triplets' bisectors
         // already, and a carving pair (offset 0.3% of the diagonal) across a band thinner than
         // that has both sites outside and punches a hole in it (libigl's lilium at a
         // half-thickness of 0.24%: genus 0 → 260). At the default band no round was kept.
-        let carve = if target.places_sites() && !config.train_shell { None } else { config.carve };
+        let carve = if places_sites && !config.train_shell { None } else { config.carve };
         // With carving: no crust outside the input's bounding box (not on a thin shell, whose
         // solid reaches past the surface by its half-thickness). The guard runs before carving,
         // so that carving judges the crust as it will be written (a farthest crust vertex past
@@ -258,9 +500,9 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         // one for a dent was kept, Hausdorff 0.25 → 0.36%), and again after carving's kept
         // rounds, whose cells may run past the box.
         let guard_box = match config.carve {
-            Some(c) if !target.places_sites() => {
-                let (lo, hi) = p.unit.bounding_box();
-                Some((lo, hi, c * diagonal))
+            Some(c) if !places_sites => {
+                let (lo, hi) = self.p.unit.bounding_box();
+                Some((lo, hi, c * self.diagonal))
             }
             _ => None,
         };
@@ -277,14 +519,16 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
         loop {
             let carving = match carve {
                 Some(c) => {
-                    let k = trainer.config().num_sites;
-                    let tolerance = c * diagonal;
+                    let k = self.trainer.config().num_sites;
+                    let tolerance = c * self.diagonal;
                     let options = crate::carve::CarveOptions {
                         mirrors,
                         gate,
                         ..crate::carve::CarveOptions::for_sites(tolerance, k)
                     };
-                    let mut r = crate::carve::carve(&mut sites, &mut labels, &oracle, &p.unit, solid, &options)?;
+                    let solid = self.target.solid();
+                    let mut r =
+                        crate::carve::carve(&mut sites, &mut labels, self.oracle, &self.p.unit, solid, &options)?;
                     r.tolerance_of_diagonal = c;
                     r.mirrors_dropped = dropped.take();
                     Some(r)
@@ -292,7 +536,6 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
                 None => None,
             };
             if let Some(r) = carving.as_ref().filter(|r| r.gated) {
-                timings.crust += lap.next();
                 return Ok(Err(r.first_surface));
             }
             if let (Some(g), Some((lo, hi, threshold)), Some(r)) = (guard.as_mut(), guard_box, carving.as_ref()) {
@@ -306,164 +549,58 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
             // `voronoi-fit crust` evaluate it, so the crust of the written sites is this crust
             // to the bit (mapping by centre and scale rounds differently, and a merge of
             // vertices a few float steps apart could then go the other way).
-            let map = FrameMap::Matrix(p.transform.from_unit_matrix());
+            let map = FrameMap::Matrix(self.p.transform.from_unit_matrix());
             match crust_of(&sites, &labels, map, config.output_precision) {
-                Ok(checked) => {
-                    timings.crust += lap.next();
-                    return Ok(Ok(Attempt {
-                        sites,
-                        labels,
-                        num_projected,
-                        polish,
-                        num_relabelled,
-                        guard,
-                        carving,
-                        pruning,
-                        checked,
-                    }));
-                }
-                Err(FitError::Input(e)) if mirrored => {
-                    let Some((s, l, g)) = before_carving.clone() else { return Err(FitError::Input(e)) };
+                Ok(checked) => return Ok(Ok((sites, labels, guard, carving, pruning, checked))),
+                Err(e) if mirrored && e.is_input_fault() => {
+                    let Some((s, l, g)) = before_carving.clone() else { return Err(e) };
                     (sites, labels, guard) = (s, l, g);
                     mirrors = false;
-                    dropped = Some(e);
+                    dropped = Some(e.to_string());
                 }
-                Err(e) => {
-                    timings.crust += lap.next();
-                    return Err(e);
-                }
+                Err(e) => return Err(e),
             }
         }
-    };
-    let measure = |crust: &TriMesh| {
-        // The crust was checked when it was built, so its validity is not recomputed.
-        let opts = metrics::EvalOptions { skip_validity: true, ..Default::default() };
-        match metrics::evaluate(&p.mesh, crust, &opts) {
-            Ok(m) => MetricsReport::Done(Box::new(m)),
-            Err(e) => MetricsReport::Failed { error: e.to_string() },
-        }
-    };
-
-    // The polish's alignment term lines pairs up, and lined-up pairs are nearly cospherical:
-    // their crust has Voronoi vertices that nearly coincide. Should the crust then not
-    // survive rounding to the output's precision, everything from the polish on runs again
-    // without the term (the report's `polish.alignment_dropped`). Asked for with
-    // `--polish-align W`; by default on a closed input both crusts are built and the aligned
-    // one is kept only where it is at least as good on all four metrics against the input
-    // ([`choose_alignment`]).
-    let forced = config.polish.as_ref().is_some_and(|pc| pc.alignment.is_some());
-    let tries = config.try_alignment.is_some()
-        && !forced
-        && config.polish.is_some()
-        && !target.places_sites()
-        && p.topology.is_closed;
-    let mut measured = None;
-    let mut choice = None;
-    // No gate is passed here, so every attempt below ends with a crust.
-    let done =
-        |a: Result<Attempt, SurfaceBar>| a.map_err(|_| FitError::Failure("carving stopped without a gate".into()));
-    let mut chosen = if forced {
-        match attempt(true, None, progress, &mut timings, &mut lap) {
-            Err(FitError::Input(e)) => {
-                let mut a = done(attempt(false, None, progress, &mut timings, &mut lap)?)?;
-                if let Some(pr) = a.polish.as_mut() {
-                    pr.alignment_dropped = Some(e);
-                }
-                a
-            }
-            other => done(other?)?,
-        }
-    } else {
-        done(attempt(false, None, progress, &mut timings, &mut lap)?)?
-    };
-    if tries {
-        let t_choice = Instant::now();
-        progress.stage(Stage::Metrics);
-        let plain = measure(&chosen.checked.written.mesh);
-        timings.metrics += lap.next();
-        // Carving hardly moves a crust's Chamfer distance and normal consistency (it works
-        // where the Hausdorff distance is set), and the choice below asks for both to be no
-        // worse: an aligned crust that falls short of the plain one's on either before
-        // carving stops there, which spares its carving (on the Menger sponge, 7 of 8 rounds'
-        // worth of seconds).
-        let gate = chosen.carving.as_ref().map(|r| r.first_surface);
-        let (aligned, aligned_error, stopped) = match attempt(true, gate, progress, &mut timings, &mut lap) {
-            Ok(Ok(a)) => (Some(a), None, None),
-            Ok(Err(bar)) => (None, None, Some(bar)),
-            Err(FitError::Input(e)) => (None, Some(e), None),
-            Err(e) => return Err(e),
-        };
-        progress.stage(Stage::Metrics);
-        let aligned_metrics = aligned.as_ref().map(|a| measure(&a.checked.written.mesh));
-        timings.metrics += lap.next();
-        let mut c = choose_alignment(&plain, aligned_metrics.as_ref(), aligned_error);
-        c.before_carving = stopped.map(|aligned| BeforeCarving { plain: gate.unwrap_or_default(), aligned });
-        measured = Some(plain);
-        if let (true, Some(a), Some(m)) = (c.aligned_kept, aligned, aligned_metrics) {
-            chosen = a;
-            measured = Some(m);
-        }
-        choice = Some(PolishChoice { seconds: t_choice.elapsed().as_secs_f64(), ..c });
     }
-    let Attempt { sites, labels, num_projected, polish, num_relabelled, guard, carving, pruning, checked } = chosen;
-    let crust_mesh = checked.written.mesh.clone();
-    timings.crust += lap.next();
+}
 
-    progress.stage(Stage::Evaluate);
-    let quality = misclassification(&sampler, solid, &sites, &labels, config, diagonal)?;
-    timings.evaluate = lap.next();
+/// The sites and labels after carving and pruning, with the reports and the checked crust.
+type Carved = (
+    Vec<[f64; 3]>,
+    Vec<bool>,
+    Option<crate::guard::GuardReport>,
+    Option<crate::carve::CarveReport>,
+    Option<PruneReport>,
+    CheckedCrust,
+);
 
-    progress.stage(Stage::Metrics);
-    let metrics = match measured {
-        _ if config.skip_metrics => MetricsReport::Skipped { skipped: "not asked for".into() },
-        Some(m) => m,
-        None => measure(&crust_mesh),
-    };
-    timings.metrics += lap.next();
+/// Report field `input`.
+fn input_report(input: &TriMesh, name: &str, p: &Prepared) -> InputReport {
+    InputReport {
+        path: name.to_string(),
+        num_vertices: input.positions.len(),
+        num_triangles: input.triangles.len(),
+        is_closed: p.topology.is_closed,
+        is_manifold: p.topology.is_manifold,
+        signed_volume: p.topology.signed_volume,
+        reoriented: p.reoriented.clone(),
+    }
+}
 
-    let state = trainer.state().clone();
-    let report = FitReport {
-        format_version: 1,
-        input: InputReport {
-            path: name.clone(),
-            num_vertices: input.positions.len(),
-            num_triangles: input.triangles.len(),
-            is_closed: p.topology.is_closed,
-            is_manifold: p.topology.is_manifold,
-            signed_volume: p.topology.signed_volume,
-            reoriented: p.reoriented.clone(),
-        },
-        settings: SettingsReport {
-            train: state.config.clone(),
-            preset: config.preset.clone(),
-            samples: s.samples,
-            near_surface_sigmas_of_diagonal: s.sigmas.clone(),
-            near_surface_sigmas: train_sigmas,
-            margin: s.margin,
-            eval_samples: config.eval.samples.max(2),
-            resumed_from: config.resume.as_ref().map(|r| r.1.clone()),
-            threads: rayon::current_num_threads(),
-        },
-        solid: solid_report,
-        transform: TransformReport { center: p.transform.center, scale: p.transform.scale },
-        timings_seconds: timings,
-        losses: LossesReport::of(&state),
-        quality,
-        metrics,
-        crust: crust_report(&checked, &crust_mesh, num_projected),
-        refined_share,
-        polish,
-        polish_choice: choice,
-        relabelled_sites: config.relabel.then_some(num_relabelled),
-        carving,
-        guard,
-        pruning,
-        accuracy_target: None,
-        outputs: OutputsReport::default(),
-        total_seconds: t_all.elapsed().as_secs_f64(),
-    };
-    let sites = SitesFile { sites, inside: labels, transform: p.transform.from_unit_matrix() };
-    Ok(FitOutput { sites, crust: crust_mesh, state, report })
+/// Report field `settings`.
+fn settings_report(state: &TrainState, config: &FitConfig, train_sigmas: Vec<f64>) -> SettingsReport {
+    let s = &config.sampling;
+    SettingsReport {
+        train: state.config.clone(),
+        preset: config.preset.clone(),
+        samples: s.samples,
+        near_surface_sigmas_of_diagonal: s.sigmas.clone(),
+        near_surface_sigmas: train_sigmas,
+        margin: s.margin,
+        eval_samples: config.eval.samples.max(2),
+        resumed_from: config.resume.as_ref().map(|r| r.1.clone()),
+        threads: rayon::current_num_threads(),
+    }
 }
 
 /// Trains to the end from `initial` sites when given (else `config.train.init`),
@@ -476,7 +613,7 @@ fn train<'a>(
     config: &FitConfig,
     progress: &mut dyn Progress,
 ) -> Result<Trainer<'a>, FitError> {
-    let input = |e: soft_voronoi::TrainError| FitError::Input(e.to_string());
+    let input = FitError::TrainStart;
     let mut trainer = match &config.resume {
         Some((state, path)) => Trainer::resume(state.clone(), data, solid, path).map_err(input)?,
         None => match initial {
@@ -489,13 +626,14 @@ fn train<'a>(
     let steps = trainer.config().steps;
     progress.train_start(trainer.state().step, steps);
     while !trainer.is_done() {
-        let s = trainer.step().map_err(|e| FitError::Failure(e.to_string()))?;
+        let s = trainer.step().map_err(FitError::Training)?;
         progress.train_step(&s);
         let stop = progress.should_stop();
         if let Some(c) = &config.checkpointing {
             let due = c.every > 0 && (s.step + 1) % c.every == 0;
             if (due || stop) && !trainer.is_done() {
-                checkpoint::write(&c.path, trainer.state(), &context).map_err(|e| FitError::Failure(e.to_string()))?;
+                checkpoint::write(&c.path, trainer.state(), &context)
+                    .map_err(|source| FitError::CheckpointWrite { path: c.path.clone(), source })?;
             }
             if stop && !trainer.is_done() {
                 progress.train_end();
@@ -503,7 +641,7 @@ fn train<'a>(
             }
         } else if stop && !trainer.is_done() {
             progress.train_end();
-            return Err(FitError::Failure(format!("stopped at step {} of {steps} without a checkpoint", s.step + 1)));
+            return Err(FitError::StoppedTraining { step: s.step + 1, steps });
         }
     }
     progress.train_end();
@@ -537,16 +675,17 @@ fn polish(
             !stopped
         },
     )
-    .map_err(|e| FitError::Failure(e.to_string()))?;
+    .map_err(FitError::Polish)?;
     if stopped {
         let steps = trainer.config().steps;
         return Err(match &config.checkpointing {
             Some(c) => {
                 let context = config.checkpoint_context()?;
-                checkpoint::write(&c.path, trainer.state(), &context).map_err(|e| FitError::Failure(e.to_string()))?;
+                checkpoint::write(&c.path, trainer.state(), &context)
+                    .map_err(|source| FitError::CheckpointWrite { path: c.path.clone(), source })?;
                 FitError::Interrupted { step: steps, steps, checkpoint: c.path.clone() }
             }
-            None => FitError::Failure(format!("stopped in the polish after {} of {} steps", report.steps, pc.steps)),
+            None => FitError::StoppedPolish { step: report.steps, steps: pc.steps },
         });
     }
     Ok(report)
@@ -572,7 +711,7 @@ fn relabel(sites: &[[f64; 3]], labels: &mut [bool], k: usize, solid: &dyn Solid)
 fn prune(sites: &mut Vec<[f64; 3]>, labels: &mut Vec<bool>) -> Result<PruneReport, FitError> {
     let before = sites.len();
     let r = crust::prune::prune(sites, labels, 0, PRUNE_ROUNDS, &crust::CrustConfig::default())
-        .map_err(|e| FitError::Failure(format!("removing the sites that change nothing: {e}")))?;
+        .map_err(|source| FitError::Crust { during: "removing the sites that change nothing", source })?;
     Ok(PruneReport { removed_per_round: r.removed_per_round, sites_before: before, sites_after: sites.len() })
 }
 

@@ -4,7 +4,7 @@
 
 mod common;
 
-use fit::{fit_to_accuracy, AccuracyGoal, FitConfig, FitError, NoProgress};
+use fit::{fit_to_accuracy, AccuracyGoal, FitConfig, NoProgress};
 use mesh_io::shapes::icosphere;
 
 /// The certified Hausdorff distance of `out`'s crust to `mesh`, upper end, share of the
@@ -52,7 +52,7 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
     assert_eq!(a.met, last.hausdorff_hi_of_diagonal <= goal.hausdorff_of_diagonal);
     assert!(a.met || last.sites * 2 > goal.max_sites, "stopped early without meeting the goal");
     assert!(out.report.crust.is_closed && out.report.crust.is_manifold);
-    assert!(out.report.summary().contains("Accuracy target"));
+    assert!(out.report.details().contains("Accuracy target"));
     let json = serde_json::to_value(&out.report).unwrap();
     assert!(json["accuracy_target"]["trace"].as_array().unwrap().len() == a.trace.len());
 }
@@ -69,7 +69,7 @@ fn an_unreachable_goal_returns_the_closest_fit() {
     assert_eq!(a.sites_used, kept.sites);
     assert_eq!(out.report.settings.train.num_sites, kept.sites);
     assert_eq!(hausdorff_of(&out, &sphere), kept.hausdorff_hi_of_diagonal);
-    assert!(out.report.summary().contains("NOT met; the fit written is the closest one"));
+    assert!(out.report.details().contains("NOT met; the fit written is the closest one"));
 }
 
 #[test]
@@ -84,6 +84,6 @@ fn an_easy_goal_stops_at_the_first_round_and_bad_goals_are_refused() {
         AccuracyGoal { hausdorff_of_diagonal: f64::NAN, max_sites: 1024 },
         AccuracyGoal { hausdorff_of_diagonal: 0.01, max_sites: 64 },
     ] {
-        assert!(matches!(fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress), Err(FitError::Input(_))));
+        assert!(fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).is_err_and(|e| e.is_input_fault()));
     }
 }

@@ -33,7 +33,7 @@ fn the_crust_follows_the_solid_across_a_hole() {
     let s = &out.report.solid;
     assert_eq!(s.rule, SolidRule::Winding);
     assert!(s.cap_samples > 50, "{} cap samples", s.cap_samples);
-    assert!(out.report.summary().contains("caps"), "{}", out.report.summary());
+    assert!(out.report.details().contains("caps"), "{}", out.report.details());
     let c = &out.report.crust;
     assert!(c.is_closed && c.is_manifold && c.num_components == 1, "{c:?}");
     // Crust vertices over the hole (away from the input) lie on the level set |w| = 0.5.

@@ -76,7 +76,7 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     }
     let inserted: usize = report.inserted_per_round.iter().sum();
     assert_eq!(sites.len(), n0 + inserted);
-    assert!(inserted > 0 && inserted % 2 == 0, "{report:?}");
+    assert!(inserted > 0 && inserted.is_multiple_of(2), "{report:?}");
     // The first round's pairs stand at the spike's feet, not at input samples.
     assert_eq!(report.inserted_at_input_per_round.len(), report.inserted_per_round.len());
     assert_eq!(report.inserted_at_input_per_round[0], 0, "{report:?}");

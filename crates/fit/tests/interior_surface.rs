@@ -35,14 +35,14 @@ fn faces_inside_overlapping_bodies_are_left_out() {
     assert!((share - 1.5 / 8.5).abs() < 0.01, "interior share {share}, expected {}", 1.5 / 8.5);
     let dropped = s.interior_surface_samples_dropped as f64;
     assert!((dropped / SAMPLES as f64 - share).abs() < 1e-9, "{dropped} samples dropped for a share of {share}");
-    assert!(out.report.summary().contains("not on the solid's boundary"), "{}", out.report.summary());
+    assert!(out.report.details().contains("not on the solid's boundary"), "{}", out.report.details());
     assert!(out.report.crust.is_closed && out.report.crust.num_components == 1, "{:?}", out.report.crust);
 
     // One cube alone: every sample is on the boundary, nothing is dropped, nothing is said.
     let cube = fit::fit(&cuboid([0.0; 3], [1.0; 3]), &small("cube"), &mut NoProgress).unwrap();
     assert_eq!(cube.report.solid.interior_surface_share, Some(0.0));
     assert_eq!(cube.report.solid.interior_surface_samples_dropped, 0);
-    assert!(!cube.report.summary().contains("not on the solid's boundary"));
+    assert!(!cube.report.details().contains("not on the solid's boundary"));
 
     // A thin pin through the face: 0.06 of 6.14 (1%) inside, below the 5% at which the
     // pool is filtered: reported, nothing dropped.

@@ -36,11 +36,11 @@ fn a_box_with_flipped_triangles_is_fitted_as_the_box() {
     let fixed = fit::fit(&bad, &small("flipped"), &mut NoProgress).unwrap();
     let r = &fixed.report.input.reoriented;
     assert_eq!((r.flipped_triangles, r.pieces_changed, r.non_orientable_pieces), (3, 1, 0), "{r:?}");
-    assert!(fixed.report.summary().contains("turned around"), "{}", fixed.report.summary());
+    assert!(fixed.report.details().contains("turned around"), "{}", fixed.report.details());
     // The same fit as of the consistent box: the solid and the samples are the same.
     let want = fit::fit(&good, &small("good"), &mut NoProgress).unwrap();
     assert_eq!(fixed.sites, want.sites);
     assert_eq!(want.report.input.reoriented, mesh_io::Reorientation::default());
-    assert!(!want.report.summary().contains("turned around"));
+    assert!(!want.report.details().contains("turned around"));
     assert!(want.report.quality.misclassification < 0.02, "{}", want.report.quality.misclassification);
 }

@@ -153,7 +153,7 @@ fn the_default_keeps_the_aligned_crust_only_where_no_metric_is_worse() {
         "{b:?}"
     );
     assert!(!choice.aligned_kept && choice.aligned.is_none() && choice.plain.is_some());
-    assert!(chosen.report.summary().contains("stopped before carving"), "{}", chosen.report.summary());
+    assert!(chosen.report.details().contains("stopped before carving"), "{}", chosen.report.details());
     let plain = carved(Some(false));
     assert_eq!(plain.crust.positions, chosen.crust.positions);
     assert_eq!(plain.report.carving.as_ref().unwrap().first_surface, b.plain);

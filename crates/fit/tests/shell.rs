@@ -4,7 +4,7 @@
 
 mod common;
 
-use fit::{FitConfig, FitError, NoProgress, SolidRule};
+use fit::{FitConfig, NoProgress, SolidRule};
 use mesh_io::shapes::icosphere;
 use mesh_io::TriMesh;
 
@@ -49,7 +49,7 @@ fn a_flat_sheet_fits_a_thin_shell() {
     let far = out.crust.positions.iter().map(|p| p[2].abs()).fold(0.0, f64::max);
     assert!(far < 4.0 * h, "a crust vertex {far} off the sheet (h = {h})");
     assert!(out.report.quality.misclassification < 0.02, "{}", out.report.quality.misclassification);
-    assert!(out.report.summary().contains("thin shell"), "{}", out.report.summary());
+    assert!(out.report.details().contains("thin shell"), "{}", out.report.details());
     assert_eq!(out.report.settings.train.steps, 0, "kept as constructed");
     // Flat: the thinnest band tried holds, and is the one fitted.
     let trials = s.thickness_search.as_ref().expect("the default thickness searches");
@@ -59,7 +59,7 @@ fn a_flat_sheet_fits_a_thin_shell() {
     assert_eq!(kept[0].factor, fit::target::BAND_FACTORS[0], "{trials:?}");
     assert_eq!(kept[0].genus, trials[0].genus);
     assert!((kept[0].half_thickness_of_diagonal - s.half_thickness_of_diagonal.unwrap()).abs() < 1e-12);
-    assert!(out.report.summary().contains("thinnest"), "{}", out.report.summary());
+    assert!(out.report.details().contains("thinnest"), "{}", out.report.details());
     // Asked to train, it trains (and stays a closed slab).
     let mut c = small("sheet");
     c.train_shell = true;
@@ -104,13 +104,13 @@ fn open_patches_and_closed_meshes_get_the_right_solid() {
     };
     let out = fit::fit(&holed, &small("holed"), &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding, "{}", out.report.solid.near_surface_ambiguous_share);
-    assert!(!out.report.summary().contains("--solid shell"), "a small hole's cap is no hint: {}", out.report.summary());
+    assert!(!out.report.details().contains("--solid shell"), "a small hole's cap is no hint: {}", out.report.details());
     let out = fit::fit(&sphere, &small("sphere"), &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding);
     assert!(out.report.solid.near_surface_inside_share > 0.3);
     assert!(out.report.solid.near_surface_ambiguous_share < 0.01);
     assert!(out.report.solid.half_thickness.is_none());
-    assert!(!out.report.summary().contains("thin shell"));
+    assert!(!out.report.details().contains("thin shell"));
 }
 
 #[test]
@@ -118,7 +118,7 @@ fn asking_for_the_winding_solid_of_a_sheet_is_refused_with_the_way_out() {
     let mut c = small("sheet");
     c.sampling.solid = SolidRule::Winding;
     match fit::fit(&sheet(4), &c, &mut NoProgress) {
-        Err(e @ FitError::Input(_)) => assert!(e.to_string().contains("--solid shell"), "{e}"),
+        Err(e) if e.is_input_fault() => assert!(e.to_string().contains("--solid shell"), "{e}"),
         Err(e) => panic!("wrong error: {e}"),
         Ok(_) => panic!("a sheet has no winding-number volume"),
     }
@@ -135,7 +135,7 @@ fn an_explicit_thickness_is_used_and_checked() {
     let f = out.report.solid.half_thickness_of_diagonal.unwrap();
     assert!((f - 0.02).abs() < 1e-12, "{f}");
     c.sampling.shell_thickness = Some(-1.0);
-    assert!(matches!(fit::fit(&mesh, &c, &mut NoProgress), Err(FitError::Input(_))));
+    assert!(fit::fit(&mesh, &c, &mut NoProgress).is_err_and(|e| e.is_input_fault()));
 }
 
 #[test]
@@ -145,7 +145,7 @@ fn a_mesh_without_area_is_still_refused() {
         triangles: vec![[0, 1, 2], [0, 1, 1]],
     };
     match fit::fit(&mesh, &small("line"), &mut NoProgress) {
-        Err(e @ FitError::Input(_)) => assert!(e.to_string().contains("area"), "{e}"),
+        Err(e) if e.is_input_fault() => assert!(e.to_string().contains("area"), "{e}"),
         Err(e) => panic!("wrong error: {e}"),
         Ok(_) => panic!("a mesh with no area has nothing to fit"),
     }
@@ -216,7 +216,7 @@ fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
     let out = fit::fit(&pipe, &small("pipe"), &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding);
     assert!(out.report.solid.cap_samples > 0);
-    let summary = out.report.summary();
+    let summary = out.report.details();
     assert!(summary.contains("--solid shell fits a thin shell"), "{summary}");
     let mut c = small("pipe");
     c.sampling.solid = SolidRule::Shell;
@@ -231,7 +231,7 @@ fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
     };
     let (volume, wall) = (hausdorff(&out.report), hausdorff(&shell.report));
     assert!(volume > 0.2 && wall < 0.5 * volume, "Hausdorff as a volume {volume}, as a shell {wall}");
-    assert!(!shell.report.summary().contains("--solid shell fits"));
+    assert!(!shell.report.details().contains("--solid shell fits"));
 }
 
 /// A square sheet's band ends about h past its edges and corners: the triplets keep clear

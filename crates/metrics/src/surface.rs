@@ -25,7 +25,7 @@ use serde::Serialize;
 use crate::hausdorff::DistanceMesh;
 use crate::MetricsError;
 
-type V3 = [f64; 3];
+use vf_common::vec3::V3;
 
 /// Options of [`surface_metrics`].
 #[derive(Clone, Debug, PartialEq)]

@@ -25,7 +25,6 @@ pub mod error;
 pub mod oracle;
 pub mod order;
 pub mod sample;
-mod vec3;
 pub mod winding;
 mod workspace;
 

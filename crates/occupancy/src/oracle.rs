@@ -9,7 +9,6 @@ use crate::bvh::{build_triangle_bvh, TriangleBvh};
 use crate::config::{Config, MAX_COORDINATE};
 use crate::distance::{closest_point_slot, ClosestPoint};
 use crate::order::morton_order;
-use crate::vec3::{cross, dot, sub, V3};
 use crate::winding::crossing::{crossing_winding, degenerate_slots, Crossing};
 use crate::winding::exact::{build_caps, exact_solid_angle_sum, exact_traversal_counts, Caps};
 use crate::winding::fast::{
@@ -17,6 +16,7 @@ use crate::winding::fast::{
 };
 use crate::winding::WindingMode;
 use crate::{OccupancyError, Workspace};
+use vf_common::vec3::{cross, dot, sub, V3};
 
 /// Number of queries per rayon task in the batch functions. Fixed, so the work split
 /// never depends on the thread count (results never do either: queries are independent).

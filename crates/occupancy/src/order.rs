@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use crate::vec3::V3;
+use vf_common::vec3::V3;
 
 /// Spreads the low 21 bits of `x` to every third bit.
 fn spread(mut x: u64) -> u64 {

@@ -2,17 +2,14 @@
 //! coordinates, the covering radius of a triangle by its corners (for the Lipschitz bound)
 //! and the maximum of the lower envelope of affine functions (for the convexity bound).
 
+use vf_common::vec3::distance;
+
 use super::V3;
 
 #[inline]
 pub(super) fn at(tri: &[V3; 3], uv: [f64; 2]) -> V3 {
     let [a, b, c] = tri;
     [0, 1, 2].map(|k| a[k] + uv[0] * (b[k] - a[k]) + uv[1] * (c[k] - a[k]))
-}
-
-#[inline]
-pub(super) fn dist(p: V3, q: V3) -> f64 {
-    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
 }
 
 /// Covering radius of a triangle by its corners: the largest distance from a point of the
@@ -22,7 +19,7 @@ pub(super) fn dist(p: V3, q: V3) -> f64 {
 /// `b²c / (b² + c² − a²)` and `a²c / (a² + c² − b²)` (each ≤ c/2); half the longest edge
 /// for needles, where those formulas lose accuracy.
 pub(super) fn covering_radius(x: &[V3; 3]) -> f64 {
-    let mut s = [dist(x[1], x[2]), dist(x[2], x[0]), dist(x[0], x[1])];
+    let mut s = [distance(x[1], x[2]), distance(x[2], x[0]), distance(x[0], x[1])];
     s.sort_by(f64::total_cmp);
     let (a, b, c) = (s[0], s[1], s[2]);
     let r = if c * c >= a * a + b * b {
@@ -178,7 +175,7 @@ mod tests {
                 for j in 0..=(n - i) {
                     let uv = [i as f64 / n as f64, j as f64 / n as f64];
                     let p = at(&x, uv);
-                    worst = worst.max(dist(p, x[0]).min(dist(p, x[1])).min(dist(p, x[2])));
+                    worst = worst.max(distance(p, x[0]).min(distance(p, x[1])).min(distance(p, x[2])));
                 }
             }
             assert!(worst <= r, "{x:?}: {worst} > {r}");

@@ -3,8 +3,9 @@
 
 use occupancy::distance::closest_point_triangle::closest_point_triangle;
 use occupancy::Workspace;
+use vf_common::vec3::distance;
 
-use super::bounds::{at, covering_radius, dist, max_of_min_affine};
+use super::bounds::{at, covering_radius, max_of_min_affine};
 use super::mesh::DistanceMesh;
 use super::V3;
 
@@ -58,8 +59,11 @@ impl Engine<'_> {
             }
             let tri = tgt.corners(t[i]);
             for j in 0..3 {
-                rows[k][j] =
-                    if t[j] == t[i] { d[j] } else { dist(x[j], closest_point_triangle(x[j], tri[0], tri[1], tri[2])) };
+                rows[k][j] = if t[j] == t[i] {
+                    d[j]
+                } else {
+                    distance(x[j], closest_point_triangle(x[j], tri[0], tri[1], tri[2]))
+                };
             }
             k += 1;
         }

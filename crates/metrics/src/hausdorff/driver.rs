@@ -3,8 +3,8 @@
 //! cell that could still raise the maximum, and the widened interval.
 
 use rayon::prelude::*;
+use vf_common::vec3::distance;
 
-use super::bounds::dist;
 use super::cell::{Cell, Engine};
 use super::mesh::DistanceMesh;
 use super::passes::{pass_a, probe, query_vertices, top_pending, PassB, PassBInput, Pending, VertexDistances, Witness};
@@ -75,7 +75,7 @@ impl Scale {
                 }
             }
         }
-        let diagonal = dist(lo_box, hi_box);
+        let diagonal = distance(lo_box, hi_box);
         let rounding_margin = 128.0 * f64::EPSILON * max_abs;
         let tolerance = rel_tolerance * diagonal;
         let tol = (tolerance - 2.0 * rounding_margin).max(0.0);

@@ -97,7 +97,7 @@ pub use sphere::{
     certify_sphere_prepared, hausdorff_sphere_certified, hausdorff_sphere_certified_limited, SphereInterval,
 };
 
-type V3 = [f64; 3];
+use vf_common::vec3::V3;
 
 /// Queries per rayon task; fixed (with a fresh workspace per task) so results never depend
 /// on the thread count.

@@ -9,8 +9,8 @@ use std::collections::HashMap;
 use occupancy::distance::closest_point_triangle::closest_point_triangle;
 use occupancy::Workspace;
 use rayon::prelude::*;
+use vf_common::vec3::distance;
 
-use super::bounds::dist;
 use super::cell::{Cell, Engine, UNIT_BARY};
 use super::mesh::{query_points, DistanceMesh};
 use super::{CHUNK, V3};
@@ -199,7 +199,7 @@ fn max_corner_distance(tgt: &DistanceMesh, t: u32, x: &[V3; 3], stop_above: f64)
     let tc = tgt.corners(t);
     let mut m = 0.0f64;
     for &xj in x {
-        m = m.max(dist(xj, closest_point_triangle(xj, tc[0], tc[1], tc[2])));
+        m = m.max(distance(xj, closest_point_triangle(xj, tc[0], tc[1], tc[2])));
         if m > stop_above {
             break;
         }

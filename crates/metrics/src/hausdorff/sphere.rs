@@ -33,6 +33,7 @@ use occupancy::distance::closest_point_triangle::closest_point_triangle;
 use occupancy::{Workspace, MAX_COORDINATE};
 use rayon::prelude::*;
 use serde::Serialize;
+use vf_common::vec3::{distance, normalize};
 
 use super::mesh::DistanceMesh;
 use super::V3;
@@ -186,15 +187,6 @@ impl Ord for Patch {
     }
 }
 
-fn normalize(v: V3) -> V3 {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    v.map(|x| x / l)
-}
-
-fn norm(a: V3, b: V3) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
 /// Lower and upper bound of `d(·, mesh)` on a patch: the distance at its centre's point,
 /// and the least of two upper bounds. (1) Lipschitz: that distance plus the patch's radius
 /// around it. (2) One triangle: the patch lies in the convex hull H of its corners'
@@ -212,8 +204,8 @@ fn eval_patch(mesh: &DistanceMesh, sphere: &Sphere, corners: &[V3; 3], ws: &mut 
     let on_sphere = [0, 1, 2].map(|k| sphere.center[k] + sphere.radius * s[k]);
     let closest = mesh.bvh().closest_point(on_sphere, ws);
     let d = closest.squared_distance.sqrt();
-    let r = corners.iter().map(|&a| norm(s, a)).fold(0.0, f64::max) * sphere.radius;
-    let m = norm(closest_point_triangle([0.0; 3], corners[0], corners[1], corners[2]), [0.0; 3]);
+    let r = corners.iter().map(|&a| distance(s, a)).fold(0.0, f64::max) * sphere.radius;
+    let m = distance(closest_point_triangle([0.0; 3], corners[0], corners[1], corners[2]), [0.0; 3]);
     let mut one_triangle = f64::INFINITY;
     if m > 0.5 {
         let [ta, tb, tc] = mesh.corners(closest.triangle);
@@ -221,7 +213,7 @@ fn eval_patch(mesh: &DistanceMesh, sphere: &Sphere, corners: &[V3; 3], ws: &mut 
         for scale in [sphere.radius, sphere.radius / m] {
             for a in corners {
                 let p = [0, 1, 2].map(|k| sphere.center[k] + scale * a[k]);
-                one_triangle = one_triangle.max(norm(p, closest_point_triangle(p, ta, tb, tc)));
+                one_triangle = one_triangle.max(distance(p, closest_point_triangle(p, ta, tb, tc)));
             }
         }
     }

@@ -7,7 +7,7 @@ use obvhs::{aabb::Aabb, bvh2::builder::build_bvh2, BvhBuildParams};
 
 use super::{HotBox, TriangleBvh};
 use crate::config::BvhPreset;
-use crate::vec3::{cross, dot, sub, V3};
+use vf_common::vec3::{cross, dot, sub, V3};
 
 /// f32 value `<= x` (for the lower corner of an f32 box that must contain `x`).
 fn f32_down(x: f64) -> f32 {

@@ -13,7 +13,7 @@ pub use build::build_triangle_bvh;
 
 use obvhs::bvh2::Bvh2;
 
-use crate::vec3::V3;
+use vf_common::vec3::V3;
 
 /// A BVH over the triangles of a mesh.
 ///

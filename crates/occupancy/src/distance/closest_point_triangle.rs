@@ -1,6 +1,6 @@
 //! Exact closest point on one triangle.
 
-use crate::vec3::{add, dot, norm_squared, scale, sub, V3};
+use vf_common::vec3::{add, dot, norm_squared, scale, sub, V3};
 
 /// Closest point to `p` on the closed triangle `(a, b, c)`, by the Voronoi-region method
 /// of Ericson, *Real-Time Collision Detection* (2005), §5.1.5, in f64 (the same method

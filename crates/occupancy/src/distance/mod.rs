@@ -3,8 +3,8 @@
 pub mod closest_point_triangle;
 
 use crate::bvh::TriangleBvh;
-use crate::vec3::{box_distance_squared, norm_squared, sub, V3};
 use closest_point_triangle::closest_point_triangle;
+use vf_common::vec3::{box_distance_squared, norm_squared, sub, V3};
 
 /// The closest point of the mesh to a query.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]

@@ -9,9 +9,9 @@ pub mod rng;
 
 use rayon::prelude::*;
 
-use crate::vec3::{add, cross, dot, scale, sub, V3};
 use crate::OccupancyError;
 use rng::{ChunkRng, Stream};
+use vf_common::vec3::{add, cross, dot, scale, sub, V3};
 
 /// Points per sampling chunk (fixed: part of the definition of the sample sequence).
 pub const SAMPLE_CHUNK: usize = 4096;

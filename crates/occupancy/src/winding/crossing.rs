@@ -22,7 +22,7 @@
 use robust::{orient3d, Coord3D};
 
 use crate::bvh::TriangleBvh;
-use crate::vec3::V3;
+use vf_common::vec3::V3;
 
 /// The outcome of one crossing count.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

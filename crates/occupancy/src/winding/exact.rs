@@ -20,7 +20,7 @@ use std::collections::HashMap;
 
 use super::solid_angle::solid_angle;
 use crate::bvh::TriangleBvh;
-use crate::vec3::{box_distance_squared, V3};
+use vf_common::vec3::{box_distance_squared, V3};
 
 /// Boundary caps of the BVH nodes, in parallel arrays indexed by node id.
 #[derive(Clone, Debug, Default)]

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 
 use super::solid_angle::{solid_angle, solid_angle_lanes};
 use crate::bvh::TriangleBvh;
-use crate::vec3::{add, cross, dot, scale, sub, V3};
+use vf_common::vec3::{add, cross, dot, scale, sub, V3};
 
 /// Index of the symmetric pair `(j, k)` in the 6-entry packing xx, xy, xz, yy, yz, zz.
 const PAIR: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];

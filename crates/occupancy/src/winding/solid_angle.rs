@@ -1,6 +1,6 @@
 //! Signed solid angle of one triangle seen from a point.
 
-use crate::vec3::{dot, norm, V3};
+use vf_common::vec3::{dot, norm, V3};
 
 /// Signed solid angle Ω (steradians) subtended by triangle `(a, b, c)` at the point `q`,
 /// by the formula of Van Oosterom and Strackee (1983), "The solid angle of a plane

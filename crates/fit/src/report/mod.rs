@@ -5,7 +5,11 @@ use std::cmp::Ordering;
 use serde::Serialize;
 use soft_voronoi::{StepStats, TrainConfig, TrainState};
 
-pub use crate::target::SolidReport;
+mod stages;
+mod summary;
+
+pub use stages::{AccuracyReport, BandTrial, CarveReport, GrowthRow, GuardReport, SolidReport, SurfaceBar};
+pub use summary::{SHELL_HINT_ABOVE, SUMMARY_LINES};
 
 /// The input as read.
 #[derive(Clone, Debug, Serialize)]
@@ -271,15 +275,15 @@ pub struct FitReport {
     /// (absent when relabelling was off).
     pub relabelled_sites: Option<usize>,
     /// Sites inserted where the crust strayed from the input (absent when off).
-    pub carving: Option<crate::carve::CarveReport>,
+    pub carving: Option<CarveReport>,
     /// Outside mirror sites that cut inside cells at the input's bounding box (with
     /// carving; absent when off).
-    pub guard: Option<crate::guard::GuardReport>,
+    pub guard: Option<GuardReport>,
     /// Sites removed last because they change neither the crust nor the occupancy (absent
     /// when off).
     pub pruning: Option<PruneReport>,
     /// The accuracy target's goal and error-against-K trace, when one was asked for.
-    pub accuracy_target: Option<crate::grow::AccuracyReport>,
+    pub accuracy_target: Option<AccuracyReport>,
     /// Files written (empty until a writer fills them in).
     pub outputs: OutputsReport,
     /// Wall time of the fit, seconds.
@@ -363,77 +367,13 @@ impl PolishScores {
     }
 }
 
-impl PolishChoice {
-    /// For the summary: which crust was kept and why.
-    fn sentence(&self) -> String {
-        if let Some(b) = &self.before_carving {
-            return format!(
-                " The polish with the pairs turned along the normals was tried too and stopped before carving \
-                 (normal consistency {:.4} against {:.4}, Chamfer {:.3e} against {:.3e} in the unit cube).",
-                b.aligned.normal_consistency, b.plain.normal_consistency, b.aligned.chamfer_l1, b.plain.chamfer_l1
-            );
-        }
-        match (&self.plain, &self.aligned, &self.aligned_error) {
-            (_, _, Some(_)) => " The polish with the pairs turned along the normals was tried too; its crust could \
-                 not be written in the output's precision, so the plain one was kept (report: polish_choice)."
-                .into(),
-            (Some(a), Some(b), None) if self.aligned_kept => format!(
-                " Both polishes were run, plain and with the pairs turned along the normals; the aligned one's \
-                 crust was kept, at least as good on all four metrics (normal consistency {:.4} → {:.4}, \
-                 Hausdorff distance {:.3}% → {:.3}% of the diagonal{}).",
-                a.normal_consistency,
-                b.normal_consistency,
-                100.0 * a.hausdorff / self.diagonal,
-                100.0 * b.hausdorff / self.diagonal,
-                if b.hausdorff <= a.hausdorff {
-                    String::new()
-                } else if b.hausdorff <= b.fscore_tau.max(a.fscore_tau) {
-                    format!(
-                        ", both within the F-score's τ of {:.2}%, which counts as equal",
-                        100.0 * b.fscore_tau / self.diagonal
-                    )
-                } else {
-                    ", certified intervals that overlap, which counts as equal".to_string()
-                }
-            ),
-            (Some(a), Some(b), None) => {
-                let worse: Vec<String> = [
-                    (b.hausdorff_cmp(a) == Ordering::Greater).then(|| {
-                        format!(
-                            "Hausdorff distance {:.3}% against {:.3}% of the diagonal",
-                            100.0 * b.hausdorff / self.diagonal,
-                            100.0 * a.hausdorff / self.diagonal
-                        )
-                    }),
-                    (b.chamfer_l1 > a.chamfer_l1)
-                        .then(|| format!("Chamfer {:.3e} against {:.3e}", b.chamfer_l1, a.chamfer_l1)),
-                    (b.fscore < a.fscore).then(|| format!("F-score {:.4} against {:.4}", b.fscore, a.fscore)),
-                    (b.normal_consistency < a.normal_consistency).then(|| {
-                        format!("normal consistency {:.4} against {:.4}", b.normal_consistency, a.normal_consistency)
-                    }),
-                ]
-                .into_iter()
-                .flatten()
-                .collect();
-                format!(
-                    " The polish with the pairs turned along the normals was tried too and not kept ({}).",
-                    if worse.is_empty() { "no metric better".to_string() } else { worse.join(", ") }
-                )
-            }
-            _ => " The polish with the pairs turned along the normals was tried too; its metrics could not be \
-                  compared, so the plain one was kept."
-                .into(),
-        }
-    }
-}
-
 /// See [`PolishChoice::before_carving`].
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct BeforeCarving {
     /// The plain polish's uncarved crust.
-    pub plain: crate::carve::SurfaceBar,
+    pub plain: SurfaceBar,
     /// The aligned polish's.
-    pub aligned: crate::carve::SurfaceBar,
+    pub aligned: SurfaceBar,
 }
 
 /// The four metrics the choice compares (mesh units; F-score at 0.3% of the diagonal).
@@ -452,254 +392,6 @@ pub struct PolishScores {
     /// The F-score's distance τ (mesh units): Hausdorff distances both within it count as
     /// equal.
     pub fscore_tau: f64,
-}
-
-/// Farthest crust point from the input, as a share of its diagonal, from which the summary
-/// of a winding solid with caps suggests `--solid shell`. Whether a cap is wanted is the
-/// user's call, not a threshold's: a cap over a wide opening lies far from the input by
-/// nature. Measured at K = 8,192: an open pipe (radius 1, length 2) fitted as a volume has
-/// its caps 29% of the diagonal from it, two crossing squares 16%; of libigl's tutorial
-/// meshes, lion 15.6%, face (a mask) 15.0%, halftunnel 12.8% and camelhead 12.2% get the
-/// hint, intersection_quads (4.9%) does not, nor do the benchmark's teapots and scanned
-/// bunny, whose holes are small. The benchmark's soup (10.0%) gets it too, and is not a
-/// single surface: as a shell it measures worse (Hausdorff 17.3% against 10.0%), hence the
-/// hint's "if".
-pub const SHELL_HINT_ABOVE: f64 = 0.1;
-
-impl FitReport {
-    /// One paragraph for people: what was fitted, how well, and what the crust is.
-    pub fn summary(&self) -> String {
-        let q = &self.quality;
-        let c = &self.crust;
-        let t = &self.settings.train;
-        let metrics = match &self.metrics {
-            MetricsReport::Done(m) => format!(
-                "Against the input: Hausdorff in [{:.4e}, {:.4e}] (certified; libigl's vertex-only value {:.4e}), \
-                 Chamfer L1 {:.4e}, F-score {:.4}, IoU {}.",
-                m.hausdorff.lo,
-                m.hausdorff.hi,
-                m.hausdorff_libigl,
-                m.surface.chamfer_l1,
-                m.surface.fscore,
-                m.iou.as_ref().and_then(|i| i.iou).map_or("n/a".to_string(), |v| format!("{v:.5}"))
-            ),
-            MetricsReport::Failed { error } => format!("Metrics against the input failed: {error}."),
-            MetricsReport::Skipped { .. } => String::new(),
-        };
-        let inserted: usize = self.carving.as_ref().map_or(0, |r| r.inserted_per_round.iter().sum());
-        let carved = match &self.carving {
-            Some(r) if inserted > 0 => {
-                let pct = |d: f64| 100.0 * d * r.tolerance_of_diagonal / r.tolerance;
-                let missed = |i: usize| pct(r.input_farthest_per_round.get(i).copied().unwrap_or(0.0));
-                let at_input: usize = r.inserted_at_input_per_round.iter().sum();
-                let mirrors: usize = r.inserted_as_mirrors_per_round.iter().sum();
-                format!(
-                    " Then {inserted} sites ({at_input} at input points far from the crust, {mirrors} mirror images \
-                     across faces near them) were inserted in {} \
-                     round(s) where the crust and the input lay more than {:.2}% of the diagonal apart (farthest \
-                     crust vertex {:.3}% → {:.3}%; input point farthest from the crust {:.3}% → {:.3}%){}.",
-                    r.inserted_per_round.len(),
-                    100.0 * r.tolerance_of_diagonal,
-                    pct(r.farthest_before),
-                    pct(r.farthest_after),
-                    missed(0),
-                    missed(r.inserted_per_round.len()),
-                    if r.mirrors_dropped.is_some() {
-                        "; carving ran a second time without mirror images, as the crust with them could not be \
-                         written in the output's precision (report: carving.mirrors_dropped)"
-                    } else {
-                        ""
-                    }
-                )
-            }
-            _ => String::new(),
-        };
-        let guarded = match &self.guard {
-            Some(g) if g.inserted() > 0 => {
-                // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
-                let of_diag = self
-                    .carving
-                    .as_ref()
-                    .filter(|r| r.tolerance > 0.0)
-                    .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
-                format!(
-                    " {} outside sites were added as mirror images of inside sites across the input's bounding box, \
-                     where their cells ran past it (the crust reached {:.3}% of the diagonal beyond the box, now \
-                     {:.3}%{}).",
-                    g.inserted(),
-                    100.0 * g.beyond_before * of_diag,
-                    100.0 * g.beyond_after * of_diag,
-                    if g.skipped_outside_cube > 0 {
-                        format!("; {} mirrors would have left the unit cube and were not added", g.skipped_outside_cube)
-                    } else {
-                        String::new()
-                    }
-                )
-            }
-            _ => String::new(),
-        };
-        let carved = format!("{carved}{guarded}");
-        let polished = match &self.polish {
-            Some(p) => format!(
-                " The sites were then polished onto the surface samples ({} steps of VoroMesh's bisector loss{}, \
-                 {:.3e} → {:.3e}; sites moved {:.2e} rms).{}",
-                p.steps,
-                if p.aligned { " with the pairs turned along the surface normals over the first half" } else { "" },
-                p.loss_first,
-                p.loss_last,
-                p.move_rms,
-                self.polish_choice.as_ref().map_or(String::new(), PolishChoice::sentence)
-            ),
-            None => String::new(),
-        };
-        let shell = match (self.solid.half_thickness, self.solid.half_thickness_of_diagonal) {
-            (Some(h), Some(f)) => {
-                let search = match &self.solid.thickness_search {
-                    Some(trials) => {
-                        let kept = trials.iter().find(|t| t.kept).map_or(1.0, |t| t.factor);
-                        let broken = trials.iter().filter(|t| t.factor < kept).count();
-                        if kept < 1.0 {
-                            let thinner = match broken {
-                                0 => String::new(),
-                                n => format!("; the {n} thinner one(s) tried did not"),
-                            };
-                            format!(
-                                " That is the thinnest band tried whose crust keeps the default band's topology and \
-                                 Hausdorff distance ({kept} of the default √(A/K){thinner})."
-                            )
-                        } else {
-                            format!(
-                                " No thinner band kept the default's topology and Hausdorff distance ({} tried), so \
-                                 the default √(A/K) stays.",
-                                trials.len() - 1
-                            )
-                        }
-                    }
-                    None => String::new(),
-                };
-                format!(
-                    " The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
-                     and 0.75 in magnitude), so the sites fit a thin shell: the surface thickened by {:.4e} on each side ({:.2}% of the diagonal); the \
-                     crust is that shell's boundary.{search}",
-                    100.0 * self.solid.near_surface_ambiguous_share,
-                    h,
-                    100.0 * f
-                )
-            }
-            _ => String::new(),
-        };
-        let r = &self.input.reoriented;
-        let reoriented = if r.flipped_triangles > 0 {
-            format!(
-                " {} of the input's triangles (in {} piece(s)) were turned around to agree with their neighbours \
-                 before the solid was built: flipped against the rest of their body, they turn part of it inside out \
-                 for the winding number.",
-                r.flipped_triangles, r.pieces_changed
-            )
-        } else {
-            String::new()
-        };
-        let interior = match (self.solid.interior_surface_share, self.solid.interior_surface_samples_dropped) {
-            (Some(share), dropped) if dropped > 0 => format!(
-                " {:.1}% of the input's surface is not on the solid's boundary (the same side of the solid on \
-                 both sides: faces inside it where bodies overlap, doubled faces); its {dropped} surface samples were \
-                 left out of the initialisation, the surface term and the polish.",
-                100.0 * share
-            ),
-            _ => String::new(),
-        };
-        let interior = format!("{reoriented}{interior}");
-        let interior = if self.solid.cap_samples > 0 {
-            // Caps that leave the crust far from the input: the mesh may be a surface (a pipe,
-            // crossing panels) rather than a volume's skin with holes. Say what to try.
-            let far = match &self.metrics {
-                MetricsReport::Done(m) if m.reference_diagonal > 0.0 => {
-                    let share = m.hausdorff.directed_witness[1] / m.reference_diagonal;
-                    if share >= SHELL_HINT_ABOVE {
-                        format!(
-                            " Part of the crust (those caps) lies {:.1}% of the diagonal from the input: if the mesh is \
-                             one surface (a pipe, a mask, crossing panels) rather than the skin of a volume with holes, \
-                             --solid shell fits a thin shell around it instead.",
-                            100.0 * share
-                        )
-                    } else {
-                        String::new()
-                    }
-                }
-                _ => String::new(),
-            };
-            format!(
-                "{interior} The solid closes the input's holes by the |winding number| = 0.5 surface; {} points of \
-                 it beyond the input's edges were added to the surface samples (caps and their rims), so sites \
-                 stand there too.{far}",
-                self.solid.cap_samples
-            )
-        } else {
-            interior
-        };
-        let pruned = match &self.pruning {
-            Some(p) if p.sites_after < p.sites_before => format!(
-                " Last, {} sites whose Delaunay neighbours all carry their label were removed (they change neither \
-                 the crust nor the occupancy): the sites file holds {} sites.",
-                p.sites_before - p.sites_after,
-                p.sites_after
-            ),
-            _ => String::new(),
-        };
-        let target = match &self.accuracy_target {
-            Some(a) => {
-                let steps: Vec<String> = a
-                    .trace
-                    .iter()
-                    .map(|r| format!("{} sites: {:.3}%", r.sites, 100.0 * r.hausdorff_hi_of_diagonal))
-                    .collect();
-                format!(
-                    " Accuracy target: Hausdorff ≤ {:.3}% of the diagonal {} {} sites (budget {}; {}).",
-                    100.0 * a.goal_hausdorff_of_diagonal,
-                    if a.met { "met with" } else { "NOT met; the fit written is the closest one, with" },
-                    a.sites_used,
-                    a.max_sites,
-                    steps.join(", ")
-                )
-            }
-            None => String::new(),
-        };
-        format!(
-            "{}: fitted {} sites ({} more fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
-             misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{}{}{} Crust of \
-             {} sites ({} inside): {} triangles, {} component(s), \
-             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{}{} {}{}",
-            self.input.path,
-            t.num_sites,
-            self.settings.train.num_boundary(),
-            t.steps,
-            match &self.losses.selected {
-                Some(b) if b.step < t.steps =>
-                    format!(" (the best iterate by the evaluation batch's loss is kept: step {})", b.step),
-                _ => String::new(),
-            },
-            self.settings.eval_samples,
-            100.0 * q.misclassification,
-            100.0 * q.misclassification_ci95[0][0],
-            100.0 * q.misclassification_ci95[0][1],
-            100.0 * q.misclassification_uniform,
-            100.0 * q.misclassification_near_surface,
-            interior,
-            polished,
-            carved,
-            pruned,
-            c.num_sites,
-            c.num_inside,
-            c.num_triangles,
-            c.num_components,
-            c.genus.map_or("n/a".to_string(), |g| g.to_string()),
-            c.volume,
-            crust::output::topology_note(c.topology_before_rounding).map_or(String::new(), |n| format!(" {n}")),
-            shell,
-            metrics,
-            target
-        )
-    }
 }
 
 /// The 95% Wilson score interval of a proportion: `wrong` of `n` draws (z = 1.959964; no

@@ -1,0 +1,196 @@
+//! The stages' parts of the report: the solid chosen, the guard, carving and the accuracy
+//! target's rounds. Each stage module re-exports its own.
+
+use serde::Serialize;
+
+use crate::config::SolidRule;
+
+/// Which solid was fitted and why (report field `solid`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SolidReport {
+    /// `winding` or `shell`.
+    pub rule: SolidRule,
+    /// `auto` (chosen from the share below) or `--solid` (asked for).
+    pub chosen_by: &'static str,
+    /// Share of the near-surface training samples inside the winding-number solid.
+    pub near_surface_inside_share: f64,
+    /// Share of near-surface samples with 0.25 < |w| < 0.75 (auto takes the shell for an
+    /// open mesh at [`crate::config::SHELL_ABOVE`] or more).
+    pub near_surface_ambiguous_share: f64,
+    /// Half the shell's thickness in input units (shell only).
+    pub half_thickness: Option<f64>,
+    /// The same as a fraction of the input's bounding-box diagonal.
+    pub half_thickness_of_diagonal: Option<f64>,
+    /// How the shell's sites start (shell only; see `target::shell_sites`).
+    pub init: Option<String>,
+    /// Share of the input's surface that is not on the solid's boundary: area-uniform
+    /// surface samples with the same label a hair's breadth (1e-5 of the diagonal) to
+    /// either side, such as faces inside the solid where closed bodies overlap, doubled
+    /// faces, or parts of a soup the solid encloses (winding solid only; estimated on the
+    /// first 20,000 samples when too small to act on).
+    pub interior_surface_share: Option<f64>,
+    /// How many of the training surface samples were left out for it (they would pull
+    /// faces of the diagram where the crust has none): the initialisation, the surface
+    /// term and the polish use the rest. 0 when the share is below 5%.
+    pub interior_surface_samples_dropped: usize,
+    /// Points of the winding solid's boundary away from the input (caps across the holes
+    /// of an open mesh: the |w| = 0.5 level set, found from the uniform pool, see
+    /// `target::cap_samples`, and the rings where they meet the input's open edges, see
+    /// `target::rim_samples`) added to the surface samples, as dense as the input's, so that the
+    /// initialisation puts site pairs and the polish pulls bisectors there too (winding
+    /// solid of an open mesh only).
+    pub cap_samples: usize,
+    /// The thinner bands tried before settling on the shell's half-thickness (shell with
+    /// the default thickness and sites kept as constructed only; see `target::thinnest_band`).
+    pub thickness_search: Option<Vec<BandTrial>>,
+}
+
+/// One band tried by `target::thinnest_band`: its half-thickness, the crust's topology and its
+/// certified Hausdorff distance to the input, and whether it was taken.
+#[derive(Clone, Debug, Serialize)]
+pub struct BandTrial {
+    /// Half-thickness as a share of the default (√(A/K)).
+    pub factor: f64,
+    /// Half-thickness as a fraction of the input's bounding-box diagonal.
+    pub half_thickness_of_diagonal: f64,
+    /// Connected components of the crust of the sites as constructed.
+    pub components: usize,
+    /// Its genus (summed over components; the crust is closed and manifold, so known).
+    pub genus: Option<i64>,
+    /// Upper end of its certified Hausdorff interval to the input, a fraction of the
+    /// diagonal.
+    pub hausdorff_of_diagonal: f64,
+    /// Whether this band was kept (the default's own row is kept when no thinner one
+    /// passed).
+    pub kept: bool,
+    /// Why this band's crust could not be made or measured (then it is not kept).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// What `carve::carve` did (report field `carving`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CarveReport {
+    /// The tolerance, unit-cube lengths (and as a share of the diagonal).
+    pub tolerance: f64,
+    /// The same as a share of the input's bounding-box diagonal.
+    pub tolerance_of_diagonal: f64,
+    /// Sites inserted, per round.
+    pub inserted_per_round: Vec<usize>,
+    /// Of those, the sites of pairs at input samples far from the crust (the rest are at
+    /// the feet of crust vertices far from the input), per round.
+    pub inserted_at_input_per_round: Vec<usize>,
+    /// Of those, the mirror images of inserted sites across input faces near them
+    /// (`carve::mirror_closure`), per round.
+    pub inserted_as_mirrors_per_round: Vec<usize>,
+    /// Why carving was run again without the mirrors, if it was: the crust with them could
+    /// not be written in the output's precision (the main job then carves again from the
+    /// same sites without them).
+    pub mirrors_dropped: Option<String>,
+    /// Farthest crust vertex from the input before and after, unit-cube lengths.
+    pub farthest_before: f64,
+    /// After the last kept round.
+    pub farthest_after: f64,
+    /// The farthest crust vertex after each extraction: before any insertion, then after
+    /// each round run (kept or undone).
+    pub farthest_per_round: Vec<f64>,
+    /// The input's farthest point from the crust after each extraction (the other side of
+    /// the Hausdorff distance: dents; certified to 0.01% of the diagonal, upper end; where
+    /// part of the input is buried inside its solid, the largest over 100,000 samples of
+    /// the rest).
+    pub input_farthest_per_round: Vec<f64>,
+    /// The crust's F-score against the input at the tolerance after each extraction (from
+    /// samples; a state more than `carve::f_slack` below the first is not kept: 0.002, or a
+    /// twentieth of what the first lacks of 1 where that is more).
+    pub fscore_per_round: Vec<f64>,
+    /// Rounds run but undone: the best state (see `best_state`: least two-sided farthest
+    /// distance, then least farthest vertex, then least summed excess of the stray
+    /// vertices) came before them.
+    pub undone_rounds: usize,
+    /// The uncarved crust's Chamfer L1 distance and normal consistency against the input
+    /// (from the samples of the F-score; unit-cube lengths).
+    pub first_surface: SurfaceBar,
+    /// Whether carving stopped before its first round because the uncarved crust did not
+    /// reach `carve::CarveOptions::gate`.
+    pub gated: bool,
+}
+
+/// Chamfer L1 distance (unit-cube lengths) and normal consistency of a crust against the
+/// input, from the samples of carving's F-score.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SurfaceBar {
+    /// Chamfer L1.
+    pub chamfer_l1: f64,
+    /// Normal consistency.
+    pub normal_consistency: f64,
+}
+
+/// What `guard::guard` did (report field `guard`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct GuardReport {
+    /// The input's bounding box in unit-cube coordinates (the planes mirrored across).
+    pub box_lo: [f64; 3],
+    /// Upper corner of the box.
+    pub box_hi: [f64; 3],
+    /// Crust vertices farther than this beyond the box trigger mirrors (the carving
+    /// tolerance), unit-cube lengths.
+    pub threshold: f64,
+    /// Mirror sites added, per round (before carving).
+    pub inserted_per_round: Vec<usize>,
+    /// Mirror sites added per round when the guard ran again after carving's kept rounds
+    /// (empty when carving kept none).
+    pub inserted_after_carving: Vec<usize>,
+    /// Mirrors that would have left the unit cube (not added).
+    pub skipped_outside_cube: usize,
+    /// How far the crust reached beyond the box before and after, unit-cube lengths.
+    pub beyond_before: f64,
+    /// After the last round.
+    pub beyond_after: f64,
+}
+
+impl GuardReport {
+    /// Takes in the report of the guard's second pass, after carving.
+    pub fn after_carving(&mut self, again: GuardReport) {
+        self.inserted_after_carving = again.inserted_per_round;
+        self.skipped_outside_cube += again.skipped_outside_cube;
+        self.beyond_after = again.beyond_after;
+    }
+
+    /// Mirror sites added in both passes.
+    pub fn inserted(&self) -> usize {
+        self.inserted_per_round.iter().chain(&self.inserted_after_carving).sum()
+    }
+}
+
+/// One round of the growth.
+#[derive(Clone, Debug, Serialize)]
+pub struct GrowthRow {
+    /// Trainable sites.
+    pub sites: usize,
+    /// Certified Hausdorff interval to the input, fractions of the diagonal.
+    pub hausdorff_lo_of_diagonal: f64,
+    /// Upper end (the figure compared with the goal).
+    pub hausdorff_hi_of_diagonal: f64,
+    /// Misclassification on the fresh pool.
+    pub misclassification: f64,
+    /// Share of the pairs' candidate surface points refined (0 in the first round).
+    pub refined_share: f64,
+    /// Wall time of the round, seconds.
+    pub seconds: f64,
+}
+
+/// Report field `accuracy_target`.
+#[derive(Clone, Debug, Serialize)]
+pub struct AccuracyReport {
+    /// The goal, fraction of the diagonal.
+    pub goal_hausdorff_of_diagonal: f64,
+    /// The budget of sites.
+    pub max_sites: usize,
+    /// Whether the last round met the goal.
+    pub met: bool,
+    /// Sites of the returned fit: the round that met the goal, or when none did, the one
+    /// with the least Hausdorff distance.
+    pub sites_used: usize,
+    /// Error against K, one row per round.
+    pub trace: Vec<GrowthRow>,
+}
