@@ -100,6 +100,10 @@ pub struct Args {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// After the summary, print the whole story of the fit (the solid, the polish and its
+    /// choice, carving, pruning, every metric) and how viewers will shade the crust.
+    #[arg(short, long)]
+    pub verbose: bool,
     /// Merge vertices closer than this fraction of the bounding-box diagonal before fitting
     /// (closes float-rounding cracks of CAD exports; e.g. 1e-6). Default: exact welding only.
     #[arg(long, value_parser = mesh_io::weld::parse_tolerance)]
@@ -317,29 +321,52 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.json {
         crate::output::out!("{}", done.json);
     } else {
-        // How viewers will shade a glTF crust (docs/viewer.md).
-        let gltf = matches!(
-            mesh_io::OutputFormat::from_path(&done.outputs.mesh),
-            Ok(mesh_io::OutputFormat::Glb | mesh_io::OutputFormat::Gltf)
-        );
-        let shading = match args.normals {
-            _ if !gltf => String::new(),
-            mesh_io::Normals::Flat => " (flat-shaded; --normals crease shades smooth surfaces smooth)".into(),
-            mesh_io::Normals::Smooth => " (smooth normals)".into(),
-            mesh_io::Normals::Crease(d) => format!(" (normals creased at {d}°)"),
-        };
+        // At most five lines: what was fitted, the solid, quality, validity (the report's
+        // summary) and the files with the time; `--verbose` adds the rest.
+        let lines: Vec<String> = done.report.summary_lines().collect();
+        for line in &lines {
+            crate::output::out!("{line}");
+        }
+        // The crust in full, the files beside it by what follows the crust's stem.
+        let stem = done.outputs.mesh.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let mut beside = vec![&done.outputs.sites, &done.picture, &done.outputs.report];
+        beside.extend(done.page.as_ref());
+        let beside: Vec<String> = beside.iter().map(|p| after_stem(p, &stem)).collect();
         crate::output::out!(
-            "{} Wrote {}{shading}, {}, {} and {} in {:.1} s.",
-            done.report.summary(),
+            "Wrote {} (+ {}) in {:.1} s",
             done.outputs.mesh.display(),
-            done.outputs.sites.display(),
-            done.picture.display(),
-            done.outputs.report.display(),
+            beside.join(", "),
             done.report.total_seconds
         );
-        if let Some(page) = &done.page {
-            crate::output::out!("Wrote the viewer page {} (open it in a browser; it works offline).", page.display());
+        if args.verbose {
+            // How viewers will shade a glTF crust (docs/viewer.md).
+            let gltf = matches!(
+                mesh_io::OutputFormat::from_path(&done.outputs.mesh),
+                Ok(mesh_io::OutputFormat::Glb | mesh_io::OutputFormat::Gltf)
+            );
+            let shading = match args.normals {
+                _ if !gltf => String::new(),
+                mesh_io::Normals::Flat => {
+                    " The crust is flat-shaded; --normals crease shades smooth surfaces smooth.".into()
+                }
+                mesh_io::Normals::Smooth => " The crust carries smooth normals.".into(),
+                mesh_io::Normals::Crease(d) => format!(" The crust's normals are creased at {d}°."),
+            };
+            crate::output::out!("\n{}{shading}", done.report.details());
+            if let Some(page) = &done.page {
+                crate::output::out!("The viewer page {} works offline in a browser.", page.display());
+            }
         }
     }
     Ok(())
+}
+
+/// A file written beside the crust, named by what follows the crust's stem (`.sites.npz`),
+/// or by its whole name when it does not start with the stem.
+fn after_stem(path: &std::path::Path, stem: &str) -> String {
+    let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+    match name.strip_prefix(stem) {
+        Some(rest) if !stem.is_empty() && rest.starts_with('.') => rest.to_string(),
+        _ => name,
+    }
 }

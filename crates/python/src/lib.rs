@@ -190,7 +190,7 @@ fn fit_mesh<'py>(
         return Err(e);
     }
     let out = result.map_err(|e| match e {
-        FitError::Input(_) => input_error(e),
+        e if e.is_input_fault() => input_error(e),
         e => failure(e),
     })?;
     let mut report = out.report;

@@ -31,6 +31,12 @@ impl FitReport {
         [self.fitted_line(), self.solid_line(), self.quality_line(), self.validity_line(), self.time_line()].join("\n")
     }
 
+    /// The summary's first four lines (what was fitted, the solid, quality, validity), for
+    /// a writer that prints its own line of files and time.
+    pub fn summary_lines(&self) -> impl Iterator<Item = String> {
+        [self.fitted_line(), self.solid_line(), self.quality_line(), self.validity_line()].into_iter()
+    }
+
     /// Everything the summary leaves out, in one paragraph: the misclassification, the
     /// interior surface, caps, the polish and its choice, carving, the guard, pruning, the
     /// shell's thickness search, every metric against the input and the accuracy target.
