@@ -20,7 +20,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 
-use ::fit::{FitError, FitOptions, Progress, Stage};
+use ::fit::{FitOptions, Progress, Stage};
 use mesh_io::TriMesh;
 use soft_voronoi::StepStats;
 
