@@ -224,6 +224,14 @@ def write_md(rows, meshes, path, command):
     errs = [r for r in rows if r.get("error")]
     if errs:
         L += ["", "Failures:", ""] + [f"- {r['mesh']} / {r['method']}: {r['error']}" for r in errs]
+    renders = Path(path).parent / "real_world_renders"
+    pics = [m["name"] for m in meshes if (renders / f"{m['name']}.png").exists()]
+    if pics:
+        L += ["", "## Renders", "", "Input, then each method's output (front and side views, framed by the input's bounding "
+              "box; faces seen from behind in orange). What ours gets wrong, mesh by mesh: "
+              "`benches/real_world/MESHES.md`.", ""]
+        for n in pics:
+            L += [f"### {n}", "", f"![{n}](real_world_renders/{n}.png)", ""]
     Path(path).write_text("\n".join(L) + "\n")
 
 
@@ -257,7 +265,14 @@ def main():
     ap.add_argument("--fit-args", default="", help="more arguments of ours, one string")
     ap.add_argument("--timeout", type=float, default=600, help="seconds per fit (ours) and per evaluation")
     ap.add_argument("--no-render", action="store_true")
+    ap.add_argument("--table-only", action="store_true", help="only rewrite real_world.md from the CSV in --out")
     args = ap.parse_args()
+    if args.table_only:
+        meshes = json.loads(MESHES_JSON.read_text())["meshes"]
+        out = Path(args.out)
+        write_md(read_csv(out / "real_world.csv"), meshes, out / "real_world.md",
+                 "target/bench-venv/bin/python benches/real_world.py (see real_world.md.provenance.json)")
+        return
 
     if not Path(args.bin).exists():
         sys.exit(f"{args.bin} is missing: build it (cargo build --profile ci) or pass --bin")
