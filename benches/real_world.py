@@ -22,7 +22,8 @@ bottom face, written when missing). Methods:
   ours on that mesh (from this run, or from an earlier run's CSV in --out; 20,000 where
   ours has no output): a first run at half that count, then one more rescaled when it is
   off by more than 25 % (resolution clamped to [1,000, 100,000]; the time is the last
-  run's). The resolution used is in the `param` column.
+  run's). The resolution used is in the `param` column. The count moves in steps (the
+  octree's depth), so it can still land 2-4x from the target: see the `triangles` column.
 
 Each output is measured by `voronoi-fit eval INPUT OUTPUT --json` (certified Hausdorff
 `hi`, Chamfer L1 and the F-score at τ = 0.3 % of the input's diagonal, normal
