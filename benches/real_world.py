@@ -222,6 +222,22 @@ def write_md(rows, meshes, path, command):
                  f"{r.get('triangles') or '–'} | {fmt(r.get('hausdorff_hi_pct'), 2)} | {fmt(r.get('chamfer_l1_pct'), 3)} | "
                  f"{fmt(r.get('fscore'), 3)} | {fmt(r.get('normal_consistency'), 3)} | {fmt(r.get('iou'), 3)} | "
                  f"{valid} | {fmt(r.get('wall_s'), 1)} |")
+    by = {(r["mesh"], r["method"]): r for r in rows}
+    names = [m["name"] for m in meshes if (m["name"], "ours") in by]
+    if names:
+        def ahead(k, lower):
+            n = 0
+            for name in names:
+                try:
+                    o = float(by[(name, "ours")][k])
+                    t = [float(by[(name, b)][k]) for b in ("mesh2sdf", "pcu")]
+                except (KeyError, TypeError, ValueError):
+                    continue
+                n += all(o < x if lower else o > x for x in t)
+            return n
+        L += ["", f"Ours ahead of both baselines, of {len(names)} meshes: Hausdorff on {ahead('hausdorff_hi_pct', True)}, "
+              f"Chamfer on {ahead('chamfer_l1_pct', True)}, normal consistency on {ahead('normal_consistency', False)}, "
+              f"F-score on {ahead('fscore', False)} (a failed or timed-out fit counts as behind)."]
     errs = [r for r in rows if r.get("error")]
     if errs:
         L += ["", "Failures:", ""] + [f"- {r['mesh']} / {r['method']}: {r['error']}" for r in errs]
@@ -272,7 +288,7 @@ def main():
         meshes = json.loads(MESHES_JSON.read_text())["meshes"]
         out = Path(args.out)
         write_md(read_csv(out / "real_world.csv"), meshes, out / "real_world.md",
-                 "target/bench-venv/bin/python benches/real_world.py (see real_world.md.provenance.json)")
+                 "target/bench-venv/bin/python benches/real_world.py")
         return
 
     if not Path(args.bin).exists():
