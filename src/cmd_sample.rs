@@ -9,11 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use crate::arrays::{vec_array, Npz};
 use crate::cli_error::{CliError, InFile};
 use crate::cmd_query::add_config;
-use occupancy::sample::{near_surface, uniform_in_box, SurfaceSampler};
-use occupancy::{Config, MeshOracle, WindingMode};
-
-/// Queries per progress-bar step.
-const PROGRESS_CHUNK: usize = 1 << 16;
+use occupancy::sample::{labelled_samples, SampleSpec, SurfaceSampler};
+use occupancy::{Config, MeshOracle, OccupancyError};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -51,42 +48,22 @@ pub fn run(args: Args) -> Result<(), CliError> {
     if args.output.extension().is_none_or(|e| !e.eq_ignore_ascii_case("npz")) {
         return Err(CliError::input(format!("{}: the output must be a .npz file.", args.output.display())));
     }
-    if args.num_samples == 0 {
-        return Err(CliError::input("-n must be at least 1."));
-    }
-    if !(0.0..=1.0).contains(&args.uniform_fraction) {
-        return Err(CliError::input(format!("--uniform-fraction {} is outside [0, 1].", args.uniform_fraction)));
-    }
-    if !(args.padding.is_finite() && args.padding >= 0.0) {
-        return Err(CliError::input(format!("--padding {} must be finite and >= 0.", args.padding)));
-    }
-    if let Some(s) = args.near_sigma.iter().find(|s| !(s.is_finite() && **s >= 0.0)) {
-        return Err(CliError::input(format!("--near-sigma {s} must be finite and >= 0.")));
+    let spec = SampleSpec {
+        num_samples: args.num_samples,
+        uniform_fraction: args.uniform_fraction,
+        padding: args.padding,
+        near_sigma: args.near_sigma.clone(),
+        seed: args.seed,
+        exact: args.exact,
+    };
+    if let Err(OccupancyError::BadSampler(m)) = spec.validate() {
+        return Err(CliError::input(m));
     }
     let mesh = mesh_io::read_mesh(&args.mesh)?;
     let config = Config::default();
     let oracle = MeshOracle::from_mesh(&mesh, &config).in_file(&args.mesh)?;
 
     let n = args.num_samples;
-    let num_uniform = ((n as f64) * args.uniform_fraction).round() as usize;
-    let num_near = n - num_uniform;
-    let (lo, hi) = oracle.bounding_box();
-    let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
-    let mut glo = lo;
-    let mut ghi = hi;
-    for k in 0..3 {
-        let pad = args.padding * (hi[k] - lo[k]);
-        glo[k] -= pad;
-        ghi[k] += pad;
-    }
-    let mut points = uniform_in_box(glo, ghi, num_uniform, args.seed).in_file(&args.mesh)?;
-    if num_near > 0 {
-        let sampler = SurfaceSampler::from_mesh(&mesh).in_file(&args.mesh)?;
-        let sigmas: Vec<f64> = args.near_sigma.iter().map(|s| s * diag).collect();
-        points.extend(near_surface(&sampler, num_near, &sigmas, args.seed).in_file(&args.mesh)?);
-    }
-
-    let mode = if args.exact { WindingMode::Exact } else { WindingMode::Fast };
     let bar = if n >= 100_000 {
         let bar = ProgressBar::new(n as u64);
         if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} [{bar:40}] {pos}/{len} ({per_sec}, eta {eta})")
@@ -98,24 +75,22 @@ pub fn run(args: Args) -> Result<(), CliError> {
     } else {
         ProgressBar::hidden()
     };
-    let mut winding = Vec::with_capacity(n);
-    let mut occupancy = Vec::with_capacity(n);
-    let mut sdf = Vec::with_capacity(n);
-    for chunk in points.chunks(PROGRESS_CHUNK) {
-        let batch =
-            oracle.query(chunk, mode).map_err(|e| CliError::failure(format!("sampled an invalid point: {e}")))?;
-        winding.extend(batch.winding);
-        occupancy.extend(batch.occupancy);
-        sdf.extend(batch.sdf);
-        bar.inc(chunk.len() as u64);
-    }
+    let labelled = labelled_samples(&oracle, || SurfaceSampler::from_mesh(&mesh), &spec, &mut |done| {
+        bar.set_position(done as u64)
+    });
+    let samples = match labelled {
+        Err(e @ OccupancyError::BadQuery { .. }) => {
+            return Err(CliError::failure(format!("sampled an invalid point: {e}")));
+        }
+        r => r.in_file(&args.mesh)?,
+    };
     bar.finish_and_clear();
 
     let mut npz = Npz::new();
-    npz.add_rows("points", &points)?;
-    npz.add("winding", &vec_array(&winding))?;
-    npz.add("occupancy", &vec_array(&occupancy))?;
-    npz.add("sdf", &vec_array(&sdf))?;
+    npz.add_rows("points", &samples.points)?;
+    npz.add("winding", &vec_array(&samples.winding))?;
+    npz.add("occupancy", &vec_array(&samples.occupancy))?;
+    npz.add("sdf", &vec_array(&samples.sdf))?;
     npz.add("near_sigma", &vec_array(&args.near_sigma))?;
     npz.add("seed", &ndarray::arr0(args.seed))?;
     add_config(&mut npz, &config, args.exact)?;

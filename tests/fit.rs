@@ -291,3 +291,27 @@ fn multibody_reports_a_real_iou() {
     // Low at these tiny settings (0.67 at the defaults), but no longer 0.
     assert!(iou > 0.1, "IoU {iou}");
 }
+
+/// A fit must not fail after its work: on the shared teapot at K = 1,024, seed 0 (default
+/// settings otherwise), the sites of carving's second round are so nearly degenerate that
+/// rounding their Voronoi vertices breaks the crust. That round is taken back and the fit
+/// writes the state before it (this run exited 1 after its work before).
+#[test]
+fn a_carving_round_without_an_extractable_crust_is_taken_back() {
+    let teapot = shared_meshes().into_iter().find(|p| p.file_name().unwrap() == "mikedh__teapot.stl").unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("teapot.glb");
+    let o = fit(&teapot, &out, &["--sites", "1024", "--seed", "0"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = report(&out);
+    assert_eq!(r["crust"]["is_closed"], true);
+    assert_eq!(r["crust"]["is_manifold"], true);
+    let c = &r["carving"];
+    // Every extraction measured is a round kept, a round undone, or the start; a round taken
+    // back was never measured.
+    let kept = c["inserted_per_round"].as_array().unwrap().len();
+    let undone = c["undone_rounds"].as_u64().unwrap() as usize;
+    assert_eq!(c["farthest_per_round"].as_array().unwrap().len(), kept + undone + 1, "{c}");
+    assert!(c["round_not_extracted"].is_null() || c["round_not_extracted"].is_string());
+    keep_for_validator(&out, "teapot_1024_seed0");
+}

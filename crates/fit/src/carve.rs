@@ -67,7 +67,9 @@ pub const ROUNDS: usize = 8;
 /// [`CarveReport::undone_rounds`]).
 ///
 /// # Errors
-/// [`FitError::Crust`] when a crust cannot be extracted; [`FitError::Occupancy`] or
+/// [`FitError::Crust`] when the crust before any insertion cannot be extracted (a round
+/// whose insertions leave no extractable crust is taken back: see
+/// [`CarveReport::round_not_extracted`]); [`FitError::Occupancy`] or
 /// [`FitError::Metrics`] when a distance cannot be measured.
 pub fn carve(
     sites: &mut Vec<[f64; 3]>,
@@ -96,8 +98,24 @@ pub fn carve(
     // One function for all rounds (about 120 lines): each round's measurements, its
     // choice of strays and its insertions share the budget, the states and the report.
     for round in 0..=rounds {
-        let crust = Crust::extract(sites, labels, &CrustConfig::default())
-            .map_err(|source| FitError::Crust { during: "crust while carving", source })?;
+        let crust = match Crust::extract(sites, labels, &CrustConfig::default()) {
+            Ok(crust) => crust,
+            // The sites with this round's insertions have no extractable crust (nearly
+            // degenerate sites whose Voronoi vertices break it when rounded): take the
+            // round back and stop at the state before it, which was extracted and checked.
+            Err(source) if round > 0 => {
+                let before = states.last().map_or(sites.len(), |s| s.sites);
+                sites.truncate(before);
+                labels.truncate(before);
+                let kept_rounds = states.len() - 1;
+                report.inserted_per_round.truncate(kept_rounds);
+                report.inserted_at_input_per_round.truncate(kept_rounds);
+                report.inserted_as_mirrors_per_round.truncate(kept_rounds);
+                report.round_not_extracted = Some(source.to_string());
+                break;
+            }
+            Err(source) => return Err(FitError::Crust { during: "crust while carving", source }),
+        };
         let far = oracle.closest_points(&crust.mesh.positions).map_err(failure)?;
         let farthest = far.iter().map(|c| c.squared_distance.sqrt()).fold(0.0, f64::max);
         let excess: f64 = far.iter().map(|c| (c.squared_distance.sqrt() - tolerance).max(0.0)).sum();

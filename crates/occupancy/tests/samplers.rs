@@ -116,3 +116,55 @@ fn sampler_errors_explain_the_problem() {
     assert!(uniform_in_box([1.0; 3], [0.0; 3], 10, 1).is_err());
     assert!(matches!(SurfaceSampler::new(&p, &[[0, 1, 99]]), Err(OccupancyError::VertexOutOfRange { .. })));
 }
+
+/// The labelled set of `voronoi-fit sample`: the uniform points first (in the padded box),
+/// then the near-surface ones; labels by the one inside rule, the signed distance negative
+/// exactly where the label is inside; reproducible from the seed; out-of-range specs named.
+#[test]
+fn labelled_samples_are_the_box_then_the_surface_with_consistent_labels() {
+    use occupancy::sample::{labelled_samples, SampleSpec, SurfaceSampler};
+    let mesh = mesh_io::shapes::cuboid([0.0; 3], [1.0, 2.0, 3.0]);
+    let oracle = occupancy::MeshOracle::from_mesh(&mesh, &occupancy::Config::default()).unwrap();
+    let spec = SampleSpec {
+        num_samples: 10_001,
+        uniform_fraction: 0.3,
+        padding: 0.1,
+        near_sigma: vec![0.01, 0.003],
+        seed: 7,
+        exact: false,
+    };
+    let mut reports = Vec::new();
+    let s = labelled_samples(&oracle, || SurfaceSampler::from_mesh(&mesh), &spec, &mut |n| reports.push(n)).unwrap();
+    assert_eq!(s.points.len(), 10_001);
+    assert_eq!((s.winding.len(), s.occupancy.len(), s.sdf.len()), (10_001, 10_001, 10_001));
+    assert_eq!(reports.last(), Some(&10_001));
+    let num_uniform = 3_000; // round(10,001 × 0.3)
+    let (lo, hi) = ([-0.1, -0.2, -0.3], [1.1, 2.2, 3.3]);
+    for p in &s.points[..num_uniform] {
+        assert!((0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]), "{p:?} outside the padded box");
+    }
+    let inside_box = |p: &[f64; 3]| (0..3).all(|k| p[k] > 0.0 && p[k] < [1.0, 2.0, 3.0][k]);
+    let mut wrong = 0;
+    for i in 0..s.points.len() {
+        assert_eq!(s.occupancy[i] == 1, s.winding[i].abs() >= 0.5, "label of point {i}");
+        assert!(s.sdf[i] == 0.0 || (s.sdf[i] < 0.0) == (s.occupancy[i] == 1), "sdf sign of point {i}");
+        wrong += usize::from(inside_box(&s.points[i]) != (s.occupancy[i] == 1));
+    }
+    // The fast winding number may differ from the box test only on the surface itself.
+    assert!(wrong <= 2, "{wrong} labels disagree with the box");
+    let diag = (1.0f64 + 4.0 + 9.0).sqrt();
+    let near = &s.sdf[num_uniform..];
+    let mean = near.iter().map(|d| d.abs()).sum::<f64>() / near.len() as f64;
+    assert!(mean < 0.02 * diag, "near-surface points are near: mean |sdf| {mean}");
+    let again = labelled_samples(&oracle, || SurfaceSampler::from_mesh(&mesh), &spec, &mut |_| {}).unwrap();
+    assert_eq!(again, s, "the same seed gives the same set");
+    for (bad, flag) in [
+        (SampleSpec { num_samples: 0, ..spec.clone() }, "-n"),
+        (SampleSpec { uniform_fraction: 1.5, ..spec.clone() }, "--uniform-fraction"),
+        (SampleSpec { padding: f64::NAN, ..spec.clone() }, "--padding"),
+        (SampleSpec { near_sigma: vec![-1.0], ..spec.clone() }, "--near-sigma"),
+    ] {
+        let e = labelled_samples(&oracle, || SurfaceSampler::from_mesh(&mesh), &bad, &mut |_| {}).unwrap_err();
+        assert!(e.to_string().contains(flag), "{e}");
+    }
+}

@@ -107,6 +107,11 @@ pub struct CarveReport {
     /// distance, then least farthest vertex, then least summed excess of the stray
     /// vertices) came before them.
     pub undone_rounds: usize,
+    /// Why the last round's insertions were taken back before they were measured, if they
+    /// were: the crust of the sites with them could not be extracted (sites so nearly
+    /// degenerate that rounding the Voronoi vertices breaks the crust). Carving then stops
+    /// at the state before that round, which was extracted and checked.
+    pub round_not_extracted: Option<String>,
     /// The uncarved crust's Chamfer L1 distance and normal consistency against the input
     /// (from the samples of the F-score; unit-cube lengths).
     pub first_surface: SurfaceBar,

@@ -204,8 +204,9 @@ impl FitReport {
                     } else {
                         ""
                     }
-                )
+                ) + &taken_back(r)
             }
+            Some(r) => taken_back(r),
             _ => String::new(),
         }
     }
@@ -453,5 +454,16 @@ impl PolishChoice {
                   compared, so the plain one was kept."
                 .into(),
         }
+    }
+}
+
+/// The sentence on a carving round taken back because its crust could not be extracted.
+fn taken_back(r: &super::CarveReport) -> String {
+    if r.round_not_extracted.is_some() {
+        " A carving round was taken back: the crust of the sites with its insertions could not be extracted \
+         (report: carving.round_not_extracted)."
+            .into()
+    } else {
+        String::new()
     }
 }

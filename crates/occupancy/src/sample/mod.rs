@@ -5,7 +5,10 @@
 //! ([`rng::ChunkRng::for_chunk`]). The chunk size is fixed, so the output depends only on
 //! the arguments, never on the number of threads.
 
+mod labelled;
 pub mod rng;
+
+pub use labelled::{labelled_samples, LabelledSamples, SampleSpec, LABEL_CHUNK};
 
 use rayon::prelude::*;
 
