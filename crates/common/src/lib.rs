@@ -7,6 +7,7 @@
 //!   trainer (f64 sites) and the MLP baselines (f32/f64 weights);
 //! - [`vec3`]: the f64 vector helpers on `[f64; 3]` (sub, dot, cross, norm, …) the
 //!   crates share, each in one fixed evaluation order;
+//! - [`text`]: thousands separators and the boxed-`From` macro of the error types;
 //! - [`npz`] (feature `npz`, on by default): an uncompressed `.npz` built in memory and
 //!   written atomically (sites files, checkpoints, CLI outputs).
 
@@ -14,6 +15,7 @@ pub mod adam;
 #[cfg(feature = "npz")]
 pub mod npz;
 pub mod rng;
+pub mod text;
 pub mod vec3;
 
 pub use adam::AdamParams;

@@ -5,7 +5,6 @@
 mod common;
 
 use fit::{FitConfig, NoProgress, SolidRule};
-use mesh_io::shapes::icosphere;
 use mesh_io::TriMesh;
 use occupancy::distance::closest_point_triangle::closest_point_segment;
 use occupancy::{Config, MeshOracle, WindingMode};
@@ -14,21 +13,9 @@ fn small(name: &str) -> FitConfig {
     common::small(name, 2048, 80, 200_000, 40_000)
 }
 
-/// A unit sphere without its cap above z = 0.5 (a hole of radius 0.87).
-fn bowl() -> TriMesh {
-    let sphere = icosphere(4);
-    let triangles = sphere
-        .triangles
-        .iter()
-        .filter(|t| t.iter().map(|&v| sphere.positions[v as usize][2]).sum::<f64>() / 3.0 < 0.5)
-        .copied()
-        .collect();
-    TriMesh { positions: sphere.positions, triangles }
-}
-
 #[test]
 fn the_crust_follows_the_solid_across_a_hole() {
-    let mesh = bowl();
+    let mesh = common::bowl(4);
     let out = fit::fit(&mesh, &small("bowl"), &mut NoProgress).unwrap();
     let s = &out.report.solid;
     assert_eq!(s.rule, SolidRule::Winding);

@@ -6,7 +6,7 @@ mod common;
 
 use fit::report::SUMMARY_LINES;
 use fit::{FitReport, NoProgress, SolidRule};
-use mesh_io::shapes::{cuboid, icosphere};
+use mesh_io::shapes::cuboid;
 use mesh_io::TriMesh;
 
 /// Longest summary line, in characters.
@@ -52,14 +52,7 @@ fn a_sheet_open_mesh_and_unmeasured_fit_keep_it_short() {
     assert!(out.report.summary().contains("thin shell"), "{}", out.report.summary());
 
     // A bowl (a sphere with a hole): the winding solid with a cap.
-    let sphere = icosphere(3);
-    let triangles = sphere
-        .triangles
-        .iter()
-        .filter(|t| t.iter().map(|&v| sphere.positions[v as usize][2]).sum::<f64>() / 3.0 < 0.5)
-        .copied()
-        .collect();
-    let bowl = TriMesh { positions: sphere.positions, triangles };
+    let bowl = common::bowl(3);
     let mut c = common::small("a/rather/long/path/to/the/bowl.obj", 1024, 20, 60_000, 20_000);
     c.skip_metrics = true;
     let out = fit::fit(&bowl, &c, &mut NoProgress).unwrap();

@@ -42,17 +42,7 @@ pub enum Error {
     Failure(String),
 }
 
-/// Boxed: a library error is large next to the `Ok` values.
-macro_rules! boxed_from {
-    ($($variant:ident: $ty:ty),*) => {$(
-        impl From<$ty> for Error {
-            fn from(e: $ty) -> Self {
-                Error::$variant(Box::new(e))
-            }
-        }
-    )*};
-}
-boxed_from!(Fit: fit::FitError, Mesh: mesh_io::MeshError, Sites: crust::SitesFileError, Viewer: viewer::Error);
+vf_common::boxed_from!(Error; Fit: fit::FitError, Mesh: mesh_io::MeshError, Sites: crust::SitesFileError, Viewer: viewer::Error);
 
 impl Error {
     /// An error in the input file `path`: `path: message`.

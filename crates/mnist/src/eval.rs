@@ -176,18 +176,7 @@ pub fn table_markdown(results: &[MethodResult]) -> String {
     s
 }
 
-/// `1234567` → `1,234,567`.
-pub fn group(n: usize) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, ch) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(ch);
-    }
-    out
-}
+pub use vf_common::text::group;
 
 #[cfg(test)]
 mod tests {

@@ -59,17 +59,7 @@ pub enum Error {
     Page(String),
 }
 
-/// Boxed: a library error is large next to the `Ok` values.
-macro_rules! boxed_from {
-    ($($variant:ident: $ty:ty),*) => {$(
-        impl From<$ty> for Error {
-            fn from(e: $ty) -> Self {
-                Error::$variant(Box::new(e))
-            }
-        }
-    )*};
-}
-boxed_from!(Mesh: mesh_io::MeshError, Sites: crust::SitesFileError, Occupancy: occupancy::OccupancyError, Plot: plot::PlotError);
+vf_common::boxed_from!(Error; Mesh: mesh_io::MeshError, Sites: crust::SitesFileError, Occupancy: occupancy::OccupancyError, Plot: plot::PlotError);
 
 impl Error {
     /// An error in the input file `path`.
@@ -90,29 +80,4 @@ impl Error {
     }
 }
 
-/// `57638` → `57,638`.
-pub fn group(n: usize) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn thousands() {
-        assert_eq!(group(0), "0");
-        assert_eq!(group(999), "999");
-        assert_eq!(group(1000), "1,000");
-        assert_eq!(group(57638), "57,638");
-        assert_eq!(group(1234567), "1,234,567");
-    }
-}
+pub use vf_common::text::group;
