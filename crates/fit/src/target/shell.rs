@@ -120,8 +120,8 @@ pub(super) fn shell_layout(plan: &ShellPlan, surface: &[[f64; 3]], h: f64, k: us
                     .map(|i| i + corners as u32),
             );
             let sites = 4 * rim.len() + 2 * rim.iter().filter(|&&i| (i as usize) < corners).count();
-            // More rim than a third of the budget: spread the rim points wider (a quarter, as
-            // before 2026-12-04, left the rim of libigl's beetle too sparse at K = 2,048).
+            // More rim than a third of the budget: spread the rim points wider (a cap of a
+            // quarter of the budget left the rim of libigl's beetle too sparse at K = 2,048).
             if sites <= k / 3 || spread > 64.0 {
                 break (rim, sites);
             }
