@@ -315,3 +315,31 @@ fn a_carving_round_without_an_extractable_crust_is_taken_back() {
     assert!(c["round_not_extracted"].is_null() || c["round_not_extracted"].is_string());
     keep_for_validator(&out, "teapot_1024_seed0");
 }
+
+/// A fit must not fail after its work: elalish/manifold's `Offset1.obj` (39 slivers far
+/// thinner than the sites' spacing; benches/real_world) leaves no site inside its
+/// winding-number solid after training. Under `--solid auto` the fit runs again as a thin
+/// shell and says so; with `--solid winding` forced it is the input's fault (exit 2), with
+/// the way out named and nothing written. (It ended with "carving: the crust mesh has no
+/// triangles" and exit 1 after its work before.)
+#[test]
+fn a_solid_too_thin_for_any_site_falls_back_to_a_thin_shell() {
+    let mesh = root().join("benches/real_world/meshes/offset1.obj");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("offset1.glb");
+    let o = fit(&mesh, &out, &QUICK);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = report(&out);
+    assert_eq!(r["solid"]["rule"], "shell");
+    assert_eq!(r["solid"]["chosen_by"], fit::CHOSEN_AFTER_EMPTY_WINDING);
+    assert_eq!(r["crust"]["is_closed"], true);
+    assert_eq!(r["crust"]["is_manifold"], true);
+    keep_for_validator(&out, "offset1_shell_fallback");
+
+    let forced = dir.path().join("forced.glb");
+    let o = fit(&mesh, &forced, &[&QUICK[..], &["--solid", "winding"]].concat());
+    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("no site stands inside") && stderr.contains("--solid shell"), "{stderr}");
+    assert!(!forced.exists() && !forced.with_extension("report.json").exists());
+}

@@ -156,6 +156,14 @@ pub enum MeshFault {
          the surface (fill its holes), or fit a thin shell around it with --solid shell"
     )]
     NothingInside,
+    /// After training and relabelling, no site stands inside the winding-number solid: its
+    /// parts are thinner than the sites' spacing, so the crust would be empty. Under
+    /// `--solid auto` the fit then fits a thin shell instead ([`crate::fit`]).
+    #[error(
+        "no site stands inside the winding-number solid after training: its parts are thinner than the sites' \
+         spacing. Fit a thin shell around the surface with --solid shell, or give more sites"
+    )]
+    NoSiteInside,
 }
 
 impl FitError {

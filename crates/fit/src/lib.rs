@@ -46,4 +46,5 @@ pub use grow::{fit_to_accuracy, AccuracyGoal};
 pub use options::FitOptions;
 pub use progress::{NoProgress, Progress, Stage};
 pub use report::FitReport;
+pub use report::CHOSEN_AFTER_EMPTY_WINDING;
 pub use run::{fit, FitOutput};

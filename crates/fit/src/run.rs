@@ -10,7 +10,7 @@ use occupancy::MeshOracle;
 use soft_voronoi::{checkpoint, classify, MeshSolid, Solid, TrainState, Trainer, TrainingData};
 
 use crate::carve::SurfaceBar;
-use crate::config::FitConfig;
+use crate::config::{FitConfig, SolidRule};
 use crate::crust_step::{crust_of, CheckedCrust};
 use crate::data::{compact, labelled_samples};
 use crate::error::{FitError, MeshFault};
@@ -158,7 +158,25 @@ impl Clock {
 /// inside), [`FitError::Settings`] and the like for settings (all with
 /// [`FitError::is_input_fault`]); [`FitError::Interrupted`] when `progress` asked to stop
 /// (after the checkpoint is written); another variant for what failed otherwise.
+///
+/// Under `--solid auto`, a winding-number solid whose parts are all thinner than the sites'
+/// spacing leaves no site inside after training (an empty crust); the fit then runs again
+/// as a thin shell around the surface, and the report's `solid.chosen_by` says so.
 pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
+    match fit_once(input, config, progress) {
+        Err(FitError::Mesh { fault: MeshFault::NoSiteInside, .. }) if config.sampling.solid == SolidRule::Auto => {
+            let mut shell = config.clone();
+            shell.sampling.solid = SolidRule::Shell;
+            let mut out = fit_once(input, &shell, progress)?;
+            out.report.solid.chosen_by = CHOSEN_AFTER_EMPTY_WINDING;
+            Ok(out)
+        }
+        r => r,
+    }
+}
+
+/// One fit with the solid rule as configured ([`fit`] adds the fallback to a thin shell).
+fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
     let t_all = Instant::now();
     config.validate()?;
     let mut clock = Clock::new();
@@ -435,6 +453,10 @@ impl AfterTraining<'_> {
         } else {
             0
         };
+        if !labels.iter().any(|&inside| inside) {
+            // An empty crust: nothing to carve or measure (see `fit`'s fallback).
+            return Err(FitError::Mesh { mesh: config.sampling.mesh.clone(), fault: MeshFault::NoSiteInside });
+        }
         let carved = self.carve_and_crust(sites, labels, gate);
         clock.timings.crust += clock.lap();
         Ok(carved?.map(|(sites, labels, guard, carving, pruning, checked)| Attempt {

@@ -8,7 +8,9 @@ use soft_voronoi::{StepStats, TrainConfig, TrainState};
 mod stages;
 mod summary;
 
-pub use stages::{AccuracyReport, BandTrial, CarveReport, GrowthRow, GuardReport, SolidReport, SurfaceBar};
+pub use stages::{
+    AccuracyReport, BandTrial, CarveReport, GrowthRow, GuardReport, SolidReport, SurfaceBar, CHOSEN_AFTER_EMPTY_WINDING,
+};
 pub use summary::{SHELL_HINT_ABOVE, SUMMARY_LINES};
 
 /// The input as read.

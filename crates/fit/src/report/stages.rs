@@ -68,6 +68,10 @@ pub struct BandTrial {
     pub error: Option<String>,
 }
 
+/// `solid.chosen_by` of a thin shell fitted because the winding-number solid left no site
+/// inside (`fit::fit`'s fallback under `--solid auto`).
+pub const CHOSEN_AFTER_EMPTY_WINDING: &str = "auto: the winding-number solid left no site inside";
+
 /// What `carve::carve` did (report field `carving`).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct CarveReport {

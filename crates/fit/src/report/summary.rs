@@ -102,7 +102,11 @@ impl FitReport {
     /// Line 2: the solid the sites fit.
     fn solid_line(&self) -> String {
         let s = &self.solid;
-        let by = if s.chosen_by == "auto" { "chosen automatically" } else { "asked for" };
+        let by = match s.chosen_by {
+            "auto" => "chosen automatically",
+            super::CHOSEN_AFTER_EMPTY_WINDING => "chosen automatically: the winding solid left no site inside",
+            _ => "asked for",
+        };
         match s.half_thickness_of_diagonal {
             Some(f) => format!("Solid: a thin shell around the surface, ±{:.3}% of the diagonal ({by})", 100.0 * f),
             None if s.cap_samples > 0 => {
