@@ -108,10 +108,13 @@ pub struct Args {
     /// (closes float-rounding cracks of CAD exports; e.g. 1e-6). Default: exact welding only.
     #[arg(long, value_parser = mesh_io::weld::parse_tolerance)]
     pub weld_tolerance: Option<f64>,
-    /// The solid to fit: `winding` (|winding number| ≥ 0.5: closed meshes, soups, open meshes
-    /// with a volume), `shell` (the surface thickened by a thin band: sheets, lone open
-    /// patches) or `auto` (winding, unless the mesh is open and its winding number stays
-    /// near ±0.5 beside most of the surface: a sheet).
+    /// The solid to fit: `winding` (|winding number| ≥ 0.5: closed meshes, soups of closed
+    /// parts, open meshes with a volume), `flood` (what a flood fill from outside cannot
+    /// reach, on the input's surface, sheets as thin bands: soups of single-sided panels,
+    /// open or flipped boxes, doubled faces), `shell` (the surface thickened by a thin band:
+    /// sheets, lone open patches) or `auto` (winding for a closed mesh; for an open one,
+    /// flood where it encloses a volume the winding number does not agree with, else shell
+    /// where the winding number stays near ±0.5 beside most of the surface, else winding).
     #[arg(long, default_value = "auto", value_parser = parse_solid)]
     pub solid: SolidRule,
     /// Thickness of the shell solid as a share of the bounding-box diagonal (`1%` or
@@ -120,6 +123,10 @@ pub struct Args {
     /// the full spacing (the report's `solid.thickness_search`).
     #[arg(long, value_parser = parse_share)]
     pub shell_thickness: Option<f64>,
+    /// Cells of the flood fill's grid along the longest side of the mesh (16 to 1024,
+    /// default 256); gaps narrower than about 2.7 cells are closed.
+    #[arg(long)]
+    pub flood_cells: Option<usize>,
     /// Ask for an accuracy instead of a K: the certified Hausdorff distance to the input as
     /// a share of its bounding-box diagonal (`0.5%` or `0.005`). The fit starts at --sites
     /// and doubles K, refining where the error was, until met or --max-sites.
@@ -189,7 +196,8 @@ fn parse_solid(s: &str) -> Result<SolidRule, String> {
         "auto" => Ok(SolidRule::Auto),
         "winding" => Ok(SolidRule::Winding),
         "shell" => Ok(SolidRule::Shell),
-        _ => Err(format!("`{s}` is not a solid; use auto, winding or shell")),
+        "flood" => Ok(SolidRule::Flood),
+        _ => Err(format!("`{s}` is not a solid; use auto, winding, shell or flood")),
     }
 }
 
@@ -220,6 +228,7 @@ impl Args {
                 eval_samples: Some(self.eval_samples),
                 solid: self.solid,
                 shell_thickness: self.shell_thickness,
+                flood_cells: self.flood_cells,
                 no_relabel: self.no_relabel,
                 carve: self.carve,
                 no_carve: self.no_carve,

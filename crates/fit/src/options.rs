@@ -51,6 +51,9 @@ pub struct FitOptions {
     pub solid: SolidRule,
     /// Shell thickness as a fraction of the diagonal.
     pub shell_thickness: Option<f64>,
+    /// Cells of the flood fill's grid along the longest side (default
+    /// [`crate::config::DEFAULT_FLOOD_CELLS`]).
+    pub flood_cells: Option<usize>,
     /// Keep the training labels.
     pub no_relabel: bool,
     /// Carving tolerance as a fraction of the diagonal (default 0.3%).
@@ -91,6 +94,12 @@ impl FitOptions {
         c.sampling.samples = self.samples.unwrap_or(c.sampling.samples);
         c.sampling.solid = self.solid;
         c.sampling.shell_thickness = self.shell_thickness;
+        if let Some(n) = self.flood_cells {
+            if !(16..=1024).contains(&n) {
+                return Err(FitError::Settings(format!("--flood-cells {n}: use 16 to 1024")));
+            }
+            c.sampling.flood_cells = n;
+        }
         c.train_shell = self.steps.is_some();
         // The paper preset is the paper's method: no polish, no relabelling, no insertion.
         c.relabel = !self.no_relabel && !paper;

@@ -30,6 +30,6 @@ pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};
 pub use polish::{PolishConfig, PolishReport};
-pub use solid::{MeshSolid, ShellSolid, Sphere};
+pub use solid::{FloodSolid, MeshSolid, ShellSolid, Sphere, SurfaceSide};
 pub use train::{classify, soft_values, BestIterate, StepStats, TrainState, Trainer, TrainingData};
 pub use vf_common::AdamParams;

@@ -9,7 +9,8 @@ mod stages;
 mod summary;
 
 pub use stages::{
-    AccuracyReport, BandTrial, CarveReport, GrowthRow, GuardReport, SolidReport, SurfaceBar, CHOSEN_AFTER_EMPTY_WINDING,
+    AccuracyReport, BandTrial, CarveReport, FloodReport, GrowthRow, GuardReport, SolidReport, SurfaceBar,
+    CHOSEN_AFTER_EMPTY_WINDING,
 };
 pub use summary::{SHELL_HINT_ABOVE, SUMMARY_LINES};
 

@@ -8,7 +8,7 @@ use crate::config::SolidRule;
 /// Which solid was fitted and why (report field `solid`).
 #[derive(Clone, Debug, Serialize)]
 pub struct SolidReport {
-    /// `winding` or `shell`.
+    /// `winding`, `shell` or `flood`.
     pub rule: SolidRule,
     /// `auto` (chosen from the share below) or `--solid` (asked for).
     pub chosen_by: &'static str,
@@ -43,6 +43,46 @@ pub struct SolidReport {
     /// The thinner bands tried before settling on the shell's half-thickness (shell with
     /// the default thickness and sites kept as constructed only; see `target::thinnest_band`).
     pub thickness_search: Option<Vec<BandTrial>>,
+    /// The flood fill and what it made of the surface (flood solid, and the auto rule's
+    /// look at it on an open mesh).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flood: Option<FloodReport>,
+}
+
+/// The flood solid's grid and which rule made which part of the surface (report field
+/// `solid.flood`). Shares are of the area-uniform surface samples.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct FloodReport {
+    /// Cells along each axis.
+    pub cells: [usize; 3],
+    /// Side of a cell, input units.
+    pub cell: f64,
+    /// The same as a share of the input's bounding-box diagonal.
+    pub cell_of_diagonal: f64,
+    /// Share of the uniform samples in cells the flood leaves enclosed (sheets' bands not
+    /// counted), against the winding-number
+    /// solid's share (the auto rule's first test, `config::FLOOD_ENCLOSED_SHARE`).
+    pub enclosed_share: f64,
+    /// Share of the uniform samples inside the winding-number solid.
+    pub winding_share: f64,
+    /// Share of the near-surface samples the two solids label differently (the auto rule's
+    /// second test, `config::FLOOD_DISAGREEMENT`).
+    pub disagreement: f64,
+    /// Surface with the flood's enclosed side on one side and outside on the other: the
+    /// solid's boundary, where the input is.
+    pub boundary_share: f64,
+    /// Surface enclosed on both sides (doubled, buried or touching faces): left out.
+    pub interior_share: f64,
+    /// Surface with the outside on both sides (single-sided panels, sheets, the walls of
+    /// boxes open wider than the grid closes): thickened into bands.
+    pub sheet_share: f64,
+    /// Surface with walls too close to step out of on both sides (inside rods and crevices
+    /// narrower than the grid resolves): enclosed, left out.
+    pub crevice_share: f64,
+    /// Half the sheets' band, input units.
+    pub sheet_half_thickness: f64,
+    /// The same as a share of the diagonal.
+    pub sheet_half_thickness_of_diagonal: f64,
 }
 
 /// One band tried by `target::thinnest_band`: its half-thickness, the crust's topology and its

@@ -5,6 +5,7 @@
 use std::cmp::Ordering;
 
 use super::{FitReport, MetricsReport, PolishChoice};
+use crate::config::SolidRule;
 
 /// Farthest crust point from the input, as a share of its diagonal, from which the details
 /// of a winding solid with caps suggests `--solid shell`. Whether a cap is wanted is the
@@ -48,7 +49,7 @@ impl FitReport {
         let polished = self.polish_sentence();
         let carved = format!("{}{}", self.carving_sentence(), self.guard_sentence());
         let pruned = self.pruning_sentence();
-        let shell = self.shell_sentence();
+        let shell = format!("{}{}", self.shell_sentence(), self.flood_sentence());
         let metrics = self.metrics_sentence();
         let target = self.accuracy_sentence();
         format!(
@@ -107,6 +108,16 @@ impl FitReport {
             super::CHOSEN_AFTER_EMPTY_WINDING => "chosen automatically: the winding solid left no site inside",
             _ => "asked for",
         };
+        if let (SolidRule::Flood, Some(f)) = (s.rule, &s.flood) {
+            return format!(
+                "Solid: flood fill from outside ({by}): {:.0}% of the surface bounds closed parts, {:.0}% are sheets \
+                 thickened ±{:.2}%, {:.0}% interior faces left out",
+                100.0 * f.boundary_share,
+                100.0 * f.sheet_share,
+                100.0 * f.sheet_half_thickness_of_diagonal,
+                100.0 * (f.interior_share + f.crevice_share)
+            );
+        }
         match s.half_thickness_of_diagonal {
             Some(f) => format!("Solid: a thin shell around the surface, ±{:.3}% of the diagonal ({by})", 100.0 * f),
             None if s.cap_samples > 0 => {
@@ -258,6 +269,36 @@ impl FitReport {
             ),
             None => String::new(),
         }
+    }
+
+    /// The flood solid: its grid and which rule made which part of the surface.
+    fn flood_sentence(&self) -> String {
+        let Some(f) = self.solid.flood.as_ref().filter(|_| self.solid.rule == SolidRule::Flood) else {
+            return String::new();
+        };
+        format!(
+            " The solid is what a flood fill from outside cannot reach ({}×{}×{} cells of {:.4e}, {:.2}% of the \
+             diagonal; gaps narrower than about 2.7 cells are closed); it encloses {:.1}% of the uniform samples, the \
+             winding-number solid {:.1}%, and the two disagree on {:.1}% of the near-surface samples. Of the input's \
+             surface, {:.1}% bounds the enclosed parts (the crust lies on it), {:.1}% has the outside on both sides \
+             (single-sided panels, sheets, walls of open boxes) and is thickened by {:.4e} on each side ({:.2}% of the \
+             diagonal), {:.1}% is enclosed on both sides (doubled, buried or touching faces) and left out, and {:.1}% \
+             lies in crevices narrower than the grid, taken as enclosed and left out too.",
+            f.cells[0],
+            f.cells[1],
+            f.cells[2],
+            f.cell,
+            100.0 * f.cell_of_diagonal,
+            100.0 * f.enclosed_share,
+            100.0 * f.winding_share,
+            100.0 * f.disagreement,
+            100.0 * f.boundary_share,
+            100.0 * f.sheet_share,
+            f.sheet_half_thickness,
+            100.0 * f.sheet_half_thickness_of_diagonal,
+            100.0 * f.interior_share,
+            100.0 * f.crevice_share
+        )
     }
 
     /// The thin shell and its thickness search (shell only).

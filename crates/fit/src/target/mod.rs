@@ -1,9 +1,13 @@
-//! The solid the sites fit: the mesh's winding-number solid, or, when that holds (almost)
-//! nothing — a zero-thickness sheet, a lone open patch — the surface thickened into a thin
-//! shell ([`ShellSolid`]), said in the report and the summary.
+//! The solid the sites fit: the mesh's winding-number solid; for a soup whose winding
+//! number is not decisive (flipped, open or single-sided parts) what a flood fill from
+//! outside leaves enclosed, with sheets as bands ([`FloodSolid`], `flood.rs`); or, when
+//! the winding solid holds (almost) nothing — a zero-thickness sheet, a lone open patch —
+//! the surface thickened into a thin shell ([`ShellSolid`]). Said in the report and the
+//! summary.
 
 mod band;
 mod caps;
+mod flood;
 mod interior;
 mod rim;
 mod shell;
@@ -11,15 +15,18 @@ mod shell;
 use mesh_io::TriMesh;
 use occupancy::sample::SurfaceSampler;
 use occupancy::MeshOracle;
-use soft_voronoi::{MeshSolid, ShellSolid, Solid, TrainingData};
+use soft_voronoi::{FloodSolid, MeshSolid, ShellSolid, Solid, TrainingData};
 
-use crate::config::{shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE};
+use crate::config::{
+    flood_sheet_half_thickness, shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE,
+};
 use crate::error::{FitError, MeshFault};
-pub use crate::report::{BandTrial, SolidReport};
+pub use crate::report::{BandTrial, FloodReport, SolidReport};
 pub use band::BAND_FACTORS;
 use band::*;
 pub use caps::cap_samples;
 use caps::*;
+use flood::*;
 use interior::*;
 use rim::*;
 use shell::*;
@@ -27,6 +34,7 @@ use shell::*;
 /// The solid in use; the shell comes with its own initial sites ([`shell_sites`]).
 pub(crate) enum Target<'a> {
     Winding(MeshSolid<'a>),
+    Flood(FloodSolid<'a>),
     Shell(ShellSolid<'a>, Vec<[f64; 3]>, Vec<bool>),
 }
 
@@ -34,6 +42,7 @@ impl Target<'_> {
     pub(crate) fn solid(&self) -> &dyn Solid {
         match self {
             Target::Winding(s) => s,
+            Target::Flood(s) => s,
             Target::Shell(s, ..) => s,
         }
     }
@@ -41,7 +50,7 @@ impl Target<'_> {
     /// Initial sites and labels when the target places them itself (the shell).
     pub(crate) fn initial_sites(&self) -> Option<(Vec<[f64; 3]>, Vec<bool>)> {
         match self {
-            Target::Winding(_) => None,
+            Target::Winding(_) | Target::Flood(_) => None,
             Target::Shell(_, sites, labels) => Some((sites.clone(), labels.clone())),
         }
     }
@@ -79,12 +88,48 @@ pub(crate) fn choose<'a>(
     let ambiguous = w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64;
     let s = &config.sampling;
     let nothing_inside = !data.occupancy.iter().any(|&o| o);
-    let (shell, chosen_by) = match s.solid {
-        SolidRule::Auto => (!is_closed && (ambiguous >= SHELL_ABOVE || nothing_inside), "auto"),
-        SolidRule::Winding => (false, "--solid"),
-        SolidRule::Shell => (true, "--solid"),
+    let h_sheet = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
+    // The flood solid is looked at for every open mesh under auto (a closed mesh's
+    // winding number is decisive).
+    let flood_sheet = |followed: f64| {
+        let area = followed * sampler.total_area();
+        flood_sheet_half_thickness(s.shell_thickness, area, config.train.num_sites, diagonal)
     };
-    if !shell {
+    let flood = match s.solid {
+        SolidRule::Flood => Some(flood_look(oracle, unit, data, num_uniform, s.flood_cells, flood_sheet)?),
+        SolidRule::Auto if !is_closed => Some(flood_look(oracle, unit, data, num_uniform, s.flood_cells, flood_sheet)?),
+        _ => None,
+    };
+    let (rule, chosen_by) = match s.solid {
+        SolidRule::Auto if flood.as_ref().is_some_and(|f| f.wanted()) => (SolidRule::Flood, "auto"),
+        SolidRule::Auto if !is_closed && (ambiguous >= SHELL_ABOVE || nothing_inside) => (SolidRule::Shell, "auto"),
+        SolidRule::Auto => (SolidRule::Winding, "auto"),
+        r => (r, "--solid"),
+    };
+    let flood_report = |f: &FloodLook| f.report(scale, diagonal);
+    if rule == SolidRule::Flood {
+        let f = flood.ok_or(FitError::Internal("the flood solid was not built"))?;
+        let report = SolidReport {
+            rule,
+            chosen_by,
+            near_surface_inside_share: share,
+            near_surface_ambiguous_share: ambiguous,
+            half_thickness: None,
+            half_thickness_of_diagonal: None,
+            init: None,
+            interior_surface_share: None,
+            interior_surface_samples_dropped: 0,
+            cap_samples: 0,
+            thickness_search: None,
+            flood: None,
+        };
+        let (solid, flood) = f.apply(data, scale, diagonal);
+        if !data.occupancy.iter().any(|&o| o) {
+            return Err(FitError::Mesh { mesh: s.mesh.clone(), fault: MeshFault::NothingInside });
+        }
+        return Ok((Target::Flood(solid), SolidReport { flood: Some(flood), ..report }));
+    }
+    if rule == SolidRule::Winding {
         if nothing_inside {
             return Err(FitError::Mesh { mesh: s.mesh.clone(), fault: MeshFault::NothingInside });
         }
@@ -115,10 +160,11 @@ pub(crate) fn choose<'a>(
             interior_surface_samples_dropped: dropped,
             cap_samples: caps,
             thickness_search: None,
+            flood: flood.as_ref().map(flood_report),
         };
         return Ok((Target::Winding(solid), report));
     }
-    let h0 = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
+    let h0 = h_sheet;
     let k = config.train.num_sites;
     let m = data.surface.len().min(12 * k);
     let plan = ShellPlan::new(unit, sampler.total_area(), &data.surface[..m], &data.normals[..m], k);
@@ -165,6 +211,7 @@ pub(crate) fn choose<'a>(
         interior_surface_samples_dropped: 0,
         cap_samples: 0,
         thickness_search,
+        flood: flood.as_ref().map(flood_report),
     };
     Ok((Target::Shell(solid, sites, labels), report))
 }
