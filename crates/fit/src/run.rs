@@ -265,6 +265,7 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
         guard,
         pruning,
         accuracy_target: None,
+        iou_reference: Some(target.iou_reference()),
         outputs: OutputsReport::default(),
         total_seconds: t_all.elapsed().as_secs_f64(),
     };
@@ -341,11 +342,37 @@ impl AfterTraining<'_> {
     /// The metrics of a crust against the input (the crust was checked when it was built,
     /// so its validity is not recomputed).
     fn measure(&self, crust: &TriMesh) -> MetricsReport {
-        let opts = metrics::EvalOptions { skip_validity: true, ..Default::default() };
-        match metrics::evaluate(&self.p.mesh, crust, &opts) {
+        let opts = metrics::EvalOptions { skip_validity: true, iou_samples: Some(0), ..Default::default() };
+        let seed = opts.surface.seed.wrapping_add(2);
+        let measured = metrics::evaluate(&self.p.mesh, crust, &opts).and_then(|mut m| {
+            m.iou = Some(self.iou_against_the_solid(crust, IOU_SAMPLES, seed)?);
+            Ok(m)
+        });
+        match measured {
             Ok(m) => MetricsReport::Done(Box::new(m)),
             Err(e) => MetricsReport::Failed { error: e.to_string() },
         }
+    }
+
+    /// IoU of the crust against the solid the sites were fitted to (the reoriented input's
+    /// winding-number solid, the flood solid or the thin shell: [`target::Target::solid`],
+    /// named in the report's `iou_reference`), on `n` points uniform in the union of the
+    /// two boxes in the unit cube; the crust's side by its own oracle.
+    fn iou_against_the_solid(
+        &self,
+        crust: &TriMesh,
+        n: usize,
+        seed: u64,
+    ) -> Result<metrics::IouResult, metrics::MetricsError> {
+        let unit = self.p.transform.mesh_to_unit(crust);
+        let oracle = MeshOracle::from_mesh(&unit, &occupancy::Config::default())?;
+        let ((l1, h1), (l2, h2)) = (self.oracle.bounding_box(), oracle.bounding_box());
+        let lo = [0, 1, 2].map(|k| l1[k].min(l2[k]));
+        let hi = [0, 1, 2].map(|k| h1[k].max(h2[k]));
+        let points = occupancy::sample::uniform_in_box(lo, hi, n, seed)?;
+        let prediction = oracle.inside(&points)?;
+        let reference = self.target.solid().inside(&points);
+        Ok(metrics::iou_of_labels(&reference, &prediction))
     }
 
     /// Everything from the polish on, once or twice: returns the attempt kept, its metrics
@@ -741,6 +768,9 @@ fn prune(sites: &mut Vec<[f64; 3]>, labels: &mut Vec<bool>) -> Result<PruneRepor
 /// round before (bunny.ply: 460, 319, 214, 149, 96, 62, 40, 31 of the 1,433 that sixteen
 /// rounds remove), at about 0.12 s a round for 8k sites.
 pub const PRUNE_ROUNDS: usize = 8;
+
+/// Uniform samples of the report's IoU (as `voronoi-fit eval`'s default).
+const IOU_SAMPLES: usize = 100_000;
 
 /// Misclassification of the hard Voronoi occupancy on a fresh pool (another seed stream
 /// than training: seed XOR [`vf_common::rng::seed_tweak::EVALUATION`]).

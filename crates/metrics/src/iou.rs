@@ -62,18 +62,24 @@ pub fn volumetric_iou(
     let pts = occupancy::sample::uniform_in_box(lo, hi, n, seed)?;
     let (lr, lp) = rayon::join(|| ra.inside(&pts), || pa.inside(&pts));
     let (lr, lp) = (lr?, lp?);
+    Ok(iou_of_labels(&lr, &lp))
+}
+
+/// IoU of two labellings of the same samples (`reference[i]`, `prediction[i]`: whether
+/// sample i is inside each solid), for solids other than a mesh's winding-number solid.
+pub fn iou_of_labels(reference: &[bool], prediction: &[bool]) -> IouResult {
     let (mut a, mut b, mut both) = (0, 0, 0);
-    for (&ia, &ib) in lr.iter().zip(&lp) {
+    for (&ia, &ib) in reference.iter().zip(prediction) {
         a += ia as usize;
         b += ib as usize;
         both += (ia && ib) as usize;
     }
     let union = a + b - both;
-    Ok(IouResult {
+    IouResult {
         iou: if union > 0 { Some(both as f64 / union as f64) } else { None },
-        num_samples: n,
+        num_samples: reference.len().min(prediction.len()),
         inside_reference: a,
         inside_prediction: b,
         inside_both: both,
-    })
+    }
 }

@@ -43,6 +43,6 @@ pub use hausdorff::{
     check_mesh, directed_hausdorff_certified, hausdorff_certified, hausdorff_libigl, hausdorff_sphere_certified,
     hausdorff_sphere_certified_limited, CertifiedOptions, DistanceMesh, HausdorffInterval, SphereInterval,
 };
-pub use iou::{volumetric_iou, IouResult};
+pub use iou::{iou_of_labels, volumetric_iou, IouResult};
 pub use surface::{surface_metrics, surface_metrics_of, SurfaceMetrics, SurfaceOptions};
 pub use validity::{validity, Validity};

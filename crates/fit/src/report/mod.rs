@@ -287,6 +287,11 @@ pub struct FitReport {
     pub pruning: Option<PruneReport>,
     /// The accuracy target's goal and error-against-K trace, when one was asked for.
     pub accuracy_target: Option<AccuracyReport>,
+    /// What `metrics.iou` is measured against: the solid the sites were fitted to (the
+    /// reoriented winding-number solid, the flood solid or the thin shell), not the raw
+    /// input's winding number (`voronoi-fit eval` measures that one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub iou_reference: Option<String>,
     /// Files written (empty until a writer fills them in).
     pub outputs: OutputsReport,
     /// Wall time of the fit, seconds.

@@ -180,13 +180,14 @@ impl FitReport {
         match &self.metrics {
             MetricsReport::Done(m) => format!(
                 "Against the input: Hausdorff in [{:.4e}, {:.4e}] (certified; libigl's vertex-only value {:.4e}), \
-                 Chamfer L1 {:.4e}, F-score {:.4}, IoU {}.",
+                 Chamfer L1 {:.4e}, F-score {:.4}, IoU {}{}.",
                 m.hausdorff.lo,
                 m.hausdorff.hi,
                 m.hausdorff_libigl,
                 m.surface.chamfer_l1,
                 m.surface.fscore,
-                m.iou.as_ref().and_then(|i| i.iou).map_or("n/a".to_string(), |v| format!("{v:.5}"))
+                m.iou.as_ref().and_then(|i| i.iou).map_or("n/a".to_string(), |v| format!("{v:.5}")),
+                self.iou_reference.as_ref().map_or(String::new(), |r| format!(" against {r}"))
             ),
             MetricsReport::Failed { error } => format!("Metrics against the input failed: {error}."),
             MetricsReport::Skipped { .. } => String::new(),

@@ -55,6 +55,20 @@ impl Target<'_> {
         }
     }
 
+    /// What the report's IoU is measured against (`FitReport::iou_reference`).
+    pub(crate) fn iou_reference(&self) -> String {
+        match self {
+            Target::Winding(_) => {
+                "the solid fitted: the winding-number solid of the input, its pieces consistently oriented".into()
+            }
+            Target::Flood(_) => "the solid fitted: the flood solid (enclosed parts, sheets' bands)".into(),
+            Target::Shell(s, ..) => format!(
+                "the solid fitted: the thin shell of half-thickness {:.3e} (unit-cube lengths)",
+                s.half_thickness
+            ),
+        }
+    }
+
     /// Whether the target places its own sites (then they are not trained by default).
     pub(crate) fn places_sites(&self) -> bool {
         matches!(self, Target::Shell(..))
