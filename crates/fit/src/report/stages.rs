@@ -59,9 +59,7 @@ pub struct FloodReport {
     pub cell: f64,
     /// The same as a share of the input's bounding-box diagonal.
     pub cell_of_diagonal: f64,
-    /// Share of the uniform samples in cells the flood leaves enclosed (sheets' bands not
-    /// counted), against the winding-number
-    /// solid's share (the auto rule's first test, `config::FLOOD_ENCLOSED_SHARE`).
+    /// Share of the uniform samples inside the flood solid without the sheets' bands.
     pub enclosed_share: f64,
     /// Share of the uniform samples inside the winding-number solid.
     pub winding_share: f64,
@@ -69,7 +67,8 @@ pub struct FloodReport {
     /// second test, `config::FLOOD_DISAGREEMENT`).
     pub disagreement: f64,
     /// Surface with the flood's enclosed side on one side and outside on the other: the
-    /// solid's boundary, where the input is.
+    /// solid's boundary, where the input is (the auto rule's first test,
+    /// `config::FLOOD_BOUNDARY_SHARE`).
     pub boundary_share: f64,
     /// Surface enclosed on both sides (doubled, buried or touching faces): left out.
     pub interior_share: f64,

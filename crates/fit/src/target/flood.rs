@@ -8,7 +8,7 @@ use occupancy::MeshOracle;
 use rayon::prelude::*;
 use soft_voronoi::{FloodSolid, Solid, SurfaceSide, TrainingData};
 
-use crate::config::{FLOOD_DISAGREEMENT, FLOOD_ENCLOSED_SHARE};
+use crate::config::{FLOOD_BOUNDARY_SHARE, FLOOD_DISAGREEMENT};
 use crate::error::FitError;
 use crate::report::FloodReport;
 
@@ -47,16 +47,19 @@ pub(super) fn flood_look<'a>(
         .map(|(&x, &n)| if n == [0.0; 3] { SurfaceSide::Crevice } else { solid.surface_side(x, n) })
         .collect();
     let followed = sides.iter().filter(|&&s| matches!(s, SurfaceSide::Boundary | SurfaceSide::Sheet)).count();
-    solid.sheet_half_thickness = h(followed as f64 / sides.len().max(1) as f64);
+    let sheet_half_thickness = h(followed as f64 / sides.len().max(1) as f64);
+    solid.sheet_half_thickness = sheet_half_thickness;
     let labels = solid.inside(&data.points);
     let share = |v: &[bool]| v.iter().filter(|&&b| b).count() as f64 / v.len().max(1) as f64;
     let u = num_uniform.min(labels.len());
     let near = labels.len() - u;
     let disagreement =
         labels[u..].iter().zip(&data.occupancy[u..]).filter(|(a, b)| a != b).count() as f64 / near.max(1) as f64;
-    // The volume the flood encloses, sheets' bands not counted.
-    let enclosed: Vec<bool> =
-        data.points[..u].iter().map(|&p| solid.grid.cell_at(p) == occupancy::flood::Cell::Enclosed).collect();
+    // The volume the flood solid holds without the sheets' bands (whose thickness is the
+    // fit's choice, not the input's): enclosed cells, and the enclosed side of the walls.
+    solid.sheet_half_thickness = 0.0;
+    let enclosed = solid.inside(&data.points[..u]);
+    solid.sheet_half_thickness = sheet_half_thickness;
     Ok(FloodLook {
         enclosed_share: share(&enclosed),
         winding_share: share(&data.occupancy[..u]),
@@ -68,11 +71,10 @@ pub(super) fn flood_look<'a>(
 }
 
 impl<'a> FloodLook<'a> {
-    /// The auto rule's test ([`FLOOD_ENCLOSED_SHARE`]).
+    /// The auto rule's test ([`FLOOD_BOUNDARY_SHARE`]).
     pub(super) fn wanted(&self) -> bool {
-        self.enclosed_share > 0.0
-            && self.enclosed_share >= FLOOD_ENCLOSED_SHARE * self.winding_share
-            && self.disagreement >= FLOOD_DISAGREEMENT
+        let boundary = self.sides.iter().filter(|&&s| s == SurfaceSide::Boundary).count();
+        boundary as f64 >= FLOOD_BOUNDARY_SHARE * self.sides.len() as f64 && self.disagreement >= FLOOD_DISAGREEMENT
     }
 
     /// The report's part, with lengths in input units (`scale` per unit-cube length).
