@@ -321,8 +321,8 @@ fn a_batch_writes_occupancy_samples_of_the_fitted_solid() {
         let truth = oracle.query(&queries, occupancy::WindingMode::Exact).unwrap();
         let rounding = 1e-3 * scale;
         let mut off = 0;
-        for i in 0..uniform {
-            if (truth.occupancy[i] == 1) != labels[i] {
+        for (i, &label) in labels[..uniform].iter().enumerate() {
+            if (truth.occupancy[i] == 1) != label {
                 off += 1;
                 assert!(truth.sdf[i].abs() < rounding, "{name}: point {i} is {} from the crust", truth.sdf[i]);
             }
