@@ -329,4 +329,20 @@ fn a_batch_writes_occupancy_samples_of_the_fitted_solid() {
         }
         assert!(off * 1000 <= uniform, "{name}: {off} of {uniform} uniform labels disagree with the crust");
     }
+    // Options out of range are refused before any work.
+    for bad in [["--occupancy", "0"], ["--occupancy-uniform-fraction", "1.5"]] {
+        let o = bin()
+            .arg("batch")
+            .arg(&input)
+            .arg("--out")
+            .arg(tmp.path().join("bad"))
+            .args(["--", "--occupancy", "10"])
+            .args(bad)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {stderr}");
+        assert!(stderr.contains(bad[0]), "{stderr}");
+        assert!(!tmp.path().join("bad").exists(), "{bad:?}: nothing written");
+    }
 }
