@@ -174,6 +174,23 @@ pub struct Args {
     /// Budget of sites for --target-hausdorff.
     #[arg(long, default_value_t = 131_072)]
     pub max_sites: usize,
+    /// Also write OUT.points.npz: N occupancy samples of the fitted solid (labelled by the
+    /// sites, i.e. inside the crust), in Occupancy Networks' layout (`points` float16 in the
+    /// mesh's normalised frame, `occupancies` packed bits, `loc`, `scale`).
+    #[arg(long, value_name = "N")]
+    pub occupancy: Option<usize>,
+    /// Share of the --occupancy points drawn uniformly in the padded cube; the rest lie near
+    /// the crust's surface (OccNet's points_uniform_ratio).
+    #[arg(long, default_value_t = 0.5)]
+    pub occupancy_uniform_fraction: f64,
+    /// Standard deviation of the near-surface --occupancy points' Gaussian offsets, in the
+    /// normalised frame (longest side of the bounding box = 1; OccNet's points_sigma).
+    #[arg(long, default_value_t = 0.01)]
+    pub occupancy_sigma: f64,
+    /// The --occupancy uniform points fill the cube of side 1 + this around the normalised
+    /// mesh (OccNet's points_padding).
+    #[arg(long, default_value_t = 0.1)]
+    pub occupancy_padding: f64,
 }
 
 /// `0.5%` → 0.005; `0.005` → 0.005.
@@ -247,6 +264,12 @@ impl Args {
             stop_after: self.stop_after,
             keep_checkpoint: self.keep_checkpoint,
             html: self.html,
+            occupancy: self.occupancy.map(|points| jobs::OccupancySpec {
+                points,
+                uniform_fraction: self.occupancy_uniform_fraction,
+                sigma: self.occupancy_sigma,
+                padding: self.occupancy_padding,
+            }),
         }
     }
 }
@@ -340,6 +363,9 @@ pub fn run(args: Args) -> Result<(), CliError> {
         let stem = done.outputs.mesh.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let mut beside = vec![&done.outputs.sites, &done.picture, &done.outputs.report];
         beside.extend(done.page.as_ref());
+        if done.report.outputs.occupancy.is_some() {
+            beside.push(&done.outputs.points);
+        }
         let beside: Vec<String> = beside.iter().map(|p| after_stem(p, &stem)).collect();
         crate::output::out!(
             "Wrote {} (+ {}) in {:.1} s",

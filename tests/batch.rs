@@ -213,3 +213,136 @@ fn jobs_do_not_change_results_and_bad_options_exit_2() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr.contains("line 1") && stderr.contains("list.txt"), "{stderr}");
 }
+
+/// The arrays of an uncompressed `.npz` (numpy's `savez`, the project's writer): name →
+/// (dtype descriptor, shape, data bytes).
+fn npz_arrays(bytes: &[u8]) -> std::collections::HashMap<String, (String, Vec<usize>, Vec<u8>)> {
+    let u16_at = |i: usize| u16::from_le_bytes([bytes[i], bytes[i + 1]]) as usize;
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+    let mut out = std::collections::HashMap::new();
+    let mut i = 0;
+    while bytes[i..].starts_with(b"PK\x03\x04") {
+        assert_eq!(u16_at(i + 8), 0, "stored, not compressed");
+        let (size, name_len, extra_len) = (u32_at(i + 18), u16_at(i + 26), u16_at(i + 28));
+        let name = String::from_utf8(bytes[i + 30..i + 30 + name_len].to_vec()).unwrap();
+        let data = &bytes[i + 30 + name_len + extra_len..i + 30 + name_len + extra_len + size];
+        assert!(data.starts_with(b"\x93NUMPY\x01\x00"), "{name}");
+        let header = std::str::from_utf8(&data[10..10 + u16::from_le_bytes([data[8], data[9]]) as usize]).unwrap();
+        let field = |key: &str, end: char| {
+            let rest = &header[header.find(key).unwrap() + key.len()..];
+            rest[..rest.find(end).unwrap()].to_string()
+        };
+        let descr = field("'descr': '", '\'');
+        let shape = field("'shape': (", ')').split(',').filter_map(|s| s.trim().parse().ok()).collect();
+        out.insert(name.trim_end_matches(".npy").to_string(), (descr, shape, data[10 + header.len()..].to_vec()));
+        i += 30 + name_len + extra_len + size;
+    }
+    out
+}
+
+/// IEEE half precision → f64.
+fn f16_to_f64(h: u16) -> f64 {
+    let sign = if h >> 15 == 1 { -1.0 } else { 1.0 };
+    let (e, m) = (((h >> 10) & 0x1f) as i32, (h & 0x3ff) as f64);
+    sign * match e {
+        0 => m * 2f64.powi(-24),
+        31 => f64::NAN,
+        _ => (1.0 + m / 1024.0) * 2f64.powi(e - 15),
+    }
+}
+
+/// `-- --occupancy N`: each folder gets NAME.voronoi.points.npz in Occupancy Networks'
+/// layout (float16 points in the normalised frame, packed bits, loc and scale), listed in
+/// the report and summary.csv; the uniform points' labels are the written crust's inside
+/// by its own winding number (off only within float16 rounding of the crust).
+#[test]
+fn a_batch_writes_occupancy_samples_of_the_fitted_solid() {
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    std::fs::copy(root().join("assets/torus.obj"), input.join("torus.obj")).unwrap();
+    let soup = shared_meshes().into_iter().find(|p| p.file_name().unwrap() == "mikedh__soup.stl").unwrap();
+    std::fs::copy(soup, input.join("soup.stl")).unwrap();
+    let out = tmp.path().join("out");
+    let n = 20_000;
+    let o = bin()
+        .arg("batch")
+        .arg(&input)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .args(FIT)
+        .args(["--occupancy", &n.to_string()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = summary(&out);
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        let name = &r["name"];
+        let path = out.join(name).join(format!("{name}.voronoi.points.npz"));
+        assert_eq!(Path::new(&r["occupancy"]), path, "{r:?}");
+        let report: serde_json::Value =
+            serde_json::from_slice(&file_bytes(out.join(name).join(format!("{name}.voronoi.report.json")))).unwrap();
+        assert!(report["outputs"]["occupancy"].as_str().unwrap().ends_with(&format!("{name}.voronoi.points.npz")));
+
+        let arrays = npz_arrays(&file_bytes(path));
+        let mut keys: Vec<&str> = arrays.keys().map(String::as_str).collect();
+        keys.sort();
+        assert_eq!(keys, ["loc", "occupancies", "points", "scale"]);
+        let (descr, shape, points) = &arrays["points"];
+        assert_eq!((descr.as_str(), shape.as_slice()), ("<f2", &[n, 3][..]));
+        let (descr, shape, packed) = &arrays["occupancies"];
+        assert_eq!((descr.as_str(), shape.as_slice()), ("|u1", &[n.div_ceil(8)][..]));
+        let (descr, shape, loc) = &arrays["loc"];
+        assert_eq!((descr.as_str(), shape.as_slice()), ("<f4", &[3][..]));
+        let (descr, shape, scale) = &arrays["scale"];
+        assert_eq!((descr.as_str(), shape.len()), ("<f4", 0));
+        let loc: Vec<f64> = loc.chunks(4).map(|b| f32::from_le_bytes(b.try_into().unwrap()) as f64).collect();
+        let scale = f32::from_le_bytes(scale[..4].try_into().unwrap()) as f64;
+        let labels: Vec<bool> = (0..n).map(|i| packed[i / 8] >> (7 - i % 8) & 1 == 1).collect();
+        let inside = labels.iter().filter(|&&b| b).count();
+        assert!(inside > 0 && inside < n, "{name}: both labels ({inside} of {n} inside)");
+        let unit: Vec<[f64; 3]> = points
+            .chunks(6)
+            .map(|b| [0, 1, 2].map(|k| f16_to_f64(u16::from_le_bytes([b[2 * k], b[2 * k + 1]]))))
+            .collect();
+        // The mesh normalised: its box centred at the origin with its longest side 1; the
+        // uniform points fill the cube of side 1.1.
+        let uniform = n / 2;
+        assert!(unit[..uniform].iter().flatten().all(|c| c.abs() <= 0.55 + 1e-3), "{name}");
+        let near_inside = labels[uniform..].iter().filter(|&&b| b).count() as f64 / (n - uniform) as f64;
+        assert!((0.2..0.8).contains(&near_inside), "{name}: near-surface points inside {near_inside}");
+
+        // The crust as written decides inside by its winding number.
+        let crust = mesh_io::read_mesh(&out.join(name).join(format!("{name}.voronoi.glb"))).unwrap();
+        let oracle = occupancy::MeshOracle::from_mesh(&crust, &occupancy::Config::default()).unwrap();
+        let queries: Vec<[f64; 3]> = unit[..uniform].iter().map(|u| [0, 1, 2].map(|k| u[k] * scale + loc[k])).collect();
+        let truth = oracle.query(&queries, occupancy::WindingMode::Exact).unwrap();
+        let rounding = 1e-3 * scale;
+        let mut off = 0;
+        for (i, &label) in labels[..uniform].iter().enumerate() {
+            if (truth.occupancy[i] == 1) != label {
+                off += 1;
+                assert!(truth.sdf[i].abs() < rounding, "{name}: point {i} is {} from the crust", truth.sdf[i]);
+            }
+        }
+        assert!(off * 1000 <= uniform, "{name}: {off} of {uniform} uniform labels disagree with the crust");
+    }
+    // Options out of range are refused before any work.
+    for bad in [["--occupancy", "0"], ["--occupancy-uniform-fraction", "1.5"]] {
+        let o = bin()
+            .arg("batch")
+            .arg(&input)
+            .arg("--out")
+            .arg(tmp.path().join("bad"))
+            .args(["--", "--occupancy", "10"])
+            .args(bad)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{bad:?}: {stderr}");
+        assert!(stderr.contains(bad[0]), "{stderr}");
+        assert!(!tmp.path().join("bad").exists(), "{bad:?}: nothing written");
+    }
+}

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from conftest import SHARED, run
+from conftest import ROOT, SHARED, run
 
 NUM_QUERIES = 100_000
 
@@ -185,3 +185,44 @@ def test_query_timings_are_json(tmp_path):
     r = run("query", SHARED / "mikedh__teapot.stl", q, "-o", tmp_path / "o.npz", "--timings")
     t = json.loads(r.stderr.strip().splitlines()[-1])
     assert t["num_queries"] == 10 and t["winding_s"] >= 0 and t["distance_s"] >= 0
+
+
+def test_batch_occupancy_samples_load_as_occupancy_networks_reads_them(tmp_path):
+    """`voronoi-fit batch -- --occupancy N` writes NAME.voronoi.points.npz as OccNet's
+    PointsField reads it (np.load, float16 points, np.unpackbits of the occupancies, loc and
+    scale), labelled by the fitted solid: the written crust's winding number by libigl on
+    points * scale + loc agrees with the uniform points' labels except within float16
+    rounding of the crust. The same command and seed write the same bytes."""
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    (meshes / "torus.obj").write_bytes((ROOT / "assets" / "torus.obj").read_bytes())
+    n = 10_000
+    fit = ["--sites", "256", "--steps", "20", "--samples", "20000", "--eval-samples", "2000", "--polish-steps", "50"]
+    for out in ("a", "b"):
+        run("batch", meshes, "--out", tmp_path / out, "--quiet", "--", *fit, "--occupancy", n, "--seed", "3")
+    path = tmp_path / "a" / "torus" / "torus.voronoi.points.npz"
+    assert path.read_bytes() == (tmp_path / "b" / "torus" / "torus.voronoi.points.npz").read_bytes()
+    d = np.load(path)
+    assert sorted(d.files) == ["loc", "occupancies", "points", "scale"]
+    points = d["points"]
+    assert points.dtype == np.float16 and points.shape == (n, 3)
+    occ = np.unpackbits(d["occupancies"])[: points.shape[0]].astype(bool)
+    assert d["occupancies"].dtype == np.uint8 and d["occupancies"].shape == ((n + 7) // 8,)
+    assert d["loc"].dtype == np.float32 and d["loc"].shape == (3,)
+    assert d["scale"].dtype == np.float32 and d["scale"].shape == ()
+    assert 0 < occ.sum() < n
+    assert np.abs(points[: n // 2]).max() <= 0.55 + 1e-3
+    crust = trimesh.load(tmp_path / "a" / "torus" / "torus.voronoi.glb", force="mesh")
+    V, F = np.asarray(crust.vertices, np.float64), np.asarray(crust.faces, np.int64)
+    # The normalised frame: the input's box centred, its longest side 1.
+    src = trimesh.load(meshes / "torus.obj", force="mesh")
+    lo, hi = src.bounds
+    assert np.allclose(d["loc"], (lo + hi) / 2, atol=1e-6 * (hi - lo).max())
+    assert np.isclose(d["scale"], (hi - lo).max(), rtol=1e-6)
+    world = points[: n // 2].astype(np.float64) * np.float64(d["scale"]) + d["loc"].astype(np.float64)
+    truth = np.abs(igl.winding_number(V, F, world)) >= 0.5
+    off = np.flatnonzero(truth != occ[: n // 2])
+    assert len(off) <= n // 2000, f"{len(off)} uniform labels disagree with the crust"
+    if len(off):
+        sqrd, _, _ = igl.point_mesh_squared_distance(world[off], V, F)
+        assert np.sqrt(sqrd).max() < 1e-3 * d["scale"]

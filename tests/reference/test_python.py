@@ -337,3 +337,35 @@ def test_cluster_tasks_follow_the_batch_protocol(tmp_path):
     assert [r["name"] for r in ours] == [r["name"] for r in theirs] == names
     assert [r["status"] for r in ours] == [r["status"] for r in theirs] == ["fitted", "fitted", "bad input"]
     assert ours[0]["triangles"] == theirs[0]["triangles"] and ours[0]["attempt_pid"]
+
+
+def test_cluster_occupancy_samples_are_the_clis(tmp_path):
+    """The Ray runner's `occupancy` option (`voronoi_fit.cluster`, here without Ray) writes
+    the same NAME.voronoi.points.npz, byte for byte, as `voronoi-fit batch -- --occupancy N`
+    with the same options, and both summaries name it in their `occupancy` column."""
+    import csv
+
+    from voronoi_fit import cluster
+
+    meshes = tmp_path / "meshes"
+    meshes.mkdir()
+    (meshes / "torus.obj").write_bytes((ROOT / "assets" / "torus.obj").read_bytes())
+    manifest = tmp_path / "manifest.txt"
+    manifest.write_text("meshes/torus.obj\n")
+    jobs = cluster.plan(manifest)
+    options = dict(sites=256, steps=20, samples=20000, eval_samples=2000, polish_steps=50, seed=0, occupancy=4000)
+    out = tmp_path / "out"
+    (out / ".work").mkdir(parents=True)
+    batch = cluster.batch_options(out, options)
+    rows = [cluster.fit_one(str(Path(p).resolve()), n, str(out), batch) for p, n in jobs]
+    assert [r["status"] for r in rows] == ["fitted"], rows
+    cluster.write_summary(out, rows, jobs)
+    bout = tmp_path / "batch"
+    run("batch", f"@{manifest}", "--out", bout, "--quiet", "--", "--sites", "256", "--steps", "20", "--samples", "20000",
+        "--eval-samples", "2000", "--polish-steps", "50", "--occupancy", "4000")
+    name = "torus.voronoi.points.npz"
+    assert (out / "torus" / name).read_bytes() == (bout / "torus" / name).read_bytes()
+    assert np.load(out / "torus" / name)["points"].shape == (4000, 3)
+    for d in (out, bout):
+        with open(d / "summary.csv") as f:
+            assert next(csv.DictReader(f))["occupancy"] == str(d / "torus" / name)

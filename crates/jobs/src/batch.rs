@@ -15,7 +15,8 @@
 //! - A mesh that fails is recorded with its error and the batch goes on; a panic in one
 //!   fit is caught and recorded the same way.
 //! - `summary.csv` ([`write_summary`], rewritten atomically after every mesh) has one row
-//!   per input: status, error, seconds and the report's figures.
+//!   per input: status, error, seconds, the report's figures, the folder and the
+//!   occupancy samples (`NAME.voronoi.points.npz`, when the fits write them).
 //! - [`run_batch`] fits `jobs` meshes at once, each on its own rayon pool of
 //!   ⌈threads / jobs⌉ threads; results do not depend on it.
 
@@ -408,6 +409,9 @@ pub fn run_batch(
     if options.jobs == 0 {
         return Err(Error::Input("a batch needs at least one job at a time".into()));
     }
+    if let Some(spec) = &options.fit.occupancy {
+        spec.validate()?;
+    }
     std::fs::create_dir_all(options.out.join(".work"))
         .map_err(|e| Error::Failure(format!("{}: cannot create the output folder ({e})", options.out.display())))?;
     mesh_io::check_output_location(&options.out.join("summary.csv"))?;
@@ -465,7 +469,7 @@ pub fn run_batch(
 /// The header of `summary.csv`.
 pub const SUMMARY_HEADER: &str =
     "name,input,status,error,seconds,hausdorff_hi,hausdorff_of_diagonal,chamfer_l1,fscore,\
-normal_consistency,iou,misclassification,sites,triangles,components,genus,folder";
+normal_consistency,iou,misclassification,sites,triangles,components,genus,folder,occupancy";
 
 /// One row of `summary.csv` before the report's figures are added.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -576,6 +580,11 @@ pub fn write_summary_rows(out: &Path, rows: &[SummaryRow], extra_columns: &[Stri
             get(&["crust", "num_components"]),
             get(&["crust", "genus"]),
             if ok { csv(&dir.display().to_string()) } else { String::new() },
+            // The occupancy samples in the finished folder (the report names the file).
+            match Path::new(&get(&["outputs", "occupancy"])).file_name() {
+                Some(f) if ok => csv(&dir.join(f).display().to_string()),
+                _ => String::new(),
+            },
         ];
         row.extend((0..extra_columns.len()).map(|k| csv(r.extra.get(k).map_or("", String::as_str))));
         text.push_str(&row.join(","));
@@ -626,8 +635,8 @@ mod tests {
         let text = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], SUMMARY_HEADER);
-        assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(12)));
-        assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(14)));
+        assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(13)));
+        assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(15)));
         // A runner's own columns go last.
         let mut row = SummaryRow::of(&jobs[1], None);
         row.extra = vec!["12".into()];

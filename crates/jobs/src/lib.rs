@@ -10,6 +10,8 @@
 pub mod batch;
 mod error;
 mod main_job;
+pub mod occupancy_samples;
 
 pub use error::{message_with_causes, Error};
 pub use main_job::{fit_to_files, FitJob, Outputs, Written};
+pub use occupancy_samples::OccupancySpec;

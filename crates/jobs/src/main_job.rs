@@ -1,6 +1,7 @@
 //! The main job for one mesh, from a [`FitJob`] to the files on disk: OUT.glb (the crust),
 //! OUT.sites.npz, OUT.png (the picture), OUT.report.json (written last: its presence
-//! means the run finished), optionally OUT.html (the viewer page), and, while training,
+//! means the run finished), optionally OUT.html (the viewer page) and OUT.points.npz (the
+//! fitted solid's occupancy samples, [`crate::occupancy_samples`]), and, while training,
 //! OUT.ckpt.npz (every `checkpoint_every` steps and when stopped; removed when the run
 //! finishes unless `keep_checkpoint`).
 
@@ -12,7 +13,8 @@ use mesh_io::{Normals, OutputFormat};
 use serde::{Deserialize, Serialize};
 use soft_voronoi::StepStats;
 
-use crate::Error;
+use crate::occupancy_samples::{self, Normalisation};
+use crate::{Error, OccupancySpec};
 
 /// The main job's options: what to fit, how (the fit options) and what to write.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -44,6 +46,9 @@ pub struct FitJob {
     pub keep_checkpoint: bool,
     /// Also write OUT.html, the viewer page.
     pub html: bool,
+    /// Also write OUT.points.npz: occupancy samples of the fitted solid in Occupancy
+    /// Networks' layout ([`crate::occupancy_samples`]), seeded by the fit's seed.
+    pub occupancy: Option<OccupancySpec>,
 }
 
 impl Default for FitJob {
@@ -61,6 +66,7 @@ impl Default for FitJob {
             stop_after: None,
             keep_checkpoint: false,
             html: false,
+            occupancy: None,
         }
     }
 }
@@ -91,6 +97,8 @@ pub struct Outputs {
     pub report: PathBuf,
     /// The checkpoint.
     pub checkpoint: PathBuf,
+    /// The occupancy samples (written only when asked for).
+    pub points: PathBuf,
 }
 
 impl Outputs {
@@ -109,7 +117,13 @@ impl Outputs {
         mesh_io::check_output_location(&mesh)?;
         let base = mesh.with_extension("");
         let with = |suffix: &str| PathBuf::from(format!("{}{suffix}", base.display()));
-        Ok(Outputs { sites: with(".sites.npz"), report: with(".report.json"), checkpoint: with(".ckpt.npz"), mesh })
+        Ok(Outputs {
+            sites: with(".sites.npz"),
+            report: with(".report.json"),
+            checkpoint: with(".ckpt.npz"),
+            points: with(".points.npz"),
+            mesh,
+        })
     }
 }
 
@@ -183,6 +197,9 @@ impl Progress for StopAfter<'_> {
 pub fn fit_to_files(job: &FitJob, progress: &mut dyn Progress) -> Result<Written, Error> {
     let t_all = Instant::now();
     let out = Outputs::of(job)?;
+    if let Some(spec) = &job.occupancy {
+        spec.validate()?;
+    }
     let config = config(job, &out)?;
     let input = read_input(job)?;
     if OutputFormat::from_path(&out.mesh)?.stores_f32() {
@@ -206,13 +223,23 @@ pub fn fit_to_files(job: &FitJob, progress: &mut dyn Progress) -> Result<Written
     write_outputs(out, result, job, t_all)
 }
 
-/// Sites file, crust, picture and report, each atomically (the report last: its presence
-/// means the run finished), and the optional page.
+/// Sites file, crust, occupancy samples (when asked for), picture and report, each
+/// atomically (the report last: its presence means the run finished), and the optional
+/// page.
 fn write_outputs(out: Outputs, result: fit::FitOutput, job: &FitJob, t_all: Instant) -> Result<Written, Error> {
     result.sites.write(&out.sites)?;
     mesh_io::write_mesh_with(&out.mesh, &result.crust, job.normals)?;
-    // OUT.png: input and crust side by side from three views (the input is read again, as
-    // only the result reaches this function; reading is cheap next to the fit).
+    // The input is read again, as only the result reaches this function; reading is cheap
+    // next to the fit.
+    let input = read_input(job)?;
+    let points = match &job.occupancy {
+        Some(spec) => {
+            write_occupancy(&out.points, spec, &input, &result, job)?;
+            Some(out.points.display().to_string())
+        }
+        None => None,
+    };
+    // OUT.png: input and crust side by side from three views.
     let picture = viewer::picture_path(&out.mesh);
     let figures = viewer::PictureFigures {
         sites_trained: result.report.settings.train.num_sites,
@@ -220,13 +247,14 @@ fn write_outputs(out: Outputs, result: fit::FitOutput, job: &FitJob, t_all: Inst
         misclassification: result.report.quality.misclassification,
         crust_triangles: result.report.crust.num_triangles,
     };
-    viewer::write_picture(&picture, &read_input(job)?, &result.crust, &job.mesh, &figures)?;
+    viewer::write_picture(&picture, &input, &result.crust, &job.mesh, &figures)?;
     let mut report = result.report;
     report.outputs = fit::report::OutputsReport {
         crust: out.mesh.display().to_string(),
         sites: out.sites.display().to_string(),
         report: out.report.display().to_string(),
         crust_normals: job.normals.to_string(),
+        occupancy: points,
     };
     report.total_seconds = t_all.elapsed().as_secs_f64();
     let json = serde_json::to_string_pretty(&report).map_err(|e| Error::Failure(format!("the report: {e}")))?;
@@ -238,6 +266,29 @@ fn write_outputs(out: Outputs, result: fit::FitOutput, job: &FitJob, t_all: Inst
     let page =
         if job.html { Some(viewer::write_fit_page(&out.mesh, &job.mesh, &out.report, &out.sites)?) } else { None };
     Ok(Written { outputs: out, report, json, picture, page })
+}
+
+/// OUT.points.npz: `spec`'s samples of the fitted solid, in the frame of the input's
+/// bounding box, labelled by the fitted sites (mapped to the input's frame, as the crust).
+fn write_occupancy(
+    path: &std::path::Path,
+    spec: &OccupancySpec,
+    input: &mesh_io::TriMesh,
+    result: &fit::FitOutput,
+    job: &FitJob,
+) -> Result<(), Error> {
+    let norm = Normalisation::of_mesh(input)
+        .ok_or_else(|| Error::input_in(&job.mesh, "no bounding box to normalise the occupancy samples by"))?;
+    let sites: Vec<[f64; 3]> = result.sites.sites.iter().map(|&p| result.sites.to_mesh_frame(p)).collect();
+    let samples = occupancy_samples::occupancy_samples(
+        spec,
+        norm,
+        &result.crust,
+        &sites,
+        &result.sites.inside,
+        job.options.seed,
+    )?;
+    occupancy_samples::write_occupancy_samples(path, &samples)
 }
 
 #[cfg(test)]

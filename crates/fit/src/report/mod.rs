@@ -222,6 +222,8 @@ pub struct OutputsReport {
     /// The normals a glTF crust carries (`flat`, `smooth` or `crease:DEG`; empty when the
     /// writer did not say).
     pub crust_normals: String,
+    /// The occupancy samples of the fitted solid (`OUT.points.npz`), when asked for.
+    pub occupancy: Option<String>,
 }
 
 /// Metrics against the input, or why they could not be computed.

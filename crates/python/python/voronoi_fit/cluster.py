@@ -58,18 +58,24 @@ def plan(manifest: Path) -> list[tuple[str, str]]:
 
 def batch_options(out: Path, options: dict) -> str:
     """The batch's options for the Rust protocol, as JSON: the fit options (the CLI's long
-    names), GLB crusts, and the options as flags recorded in each ``batch.json``."""
+    names; ``occupancy``: N occupancy samples of the fitted solid per mesh, as the CLI's
+    ``--occupancy N``), GLB crusts, and the options as flags recorded in each
+    ``batch.json``."""
     from voronoi_fit import __version__
 
     fit_args = []
     for k in sorted(options):
         fit_args += [f"--{k.replace('_', '-')}", str(options[k])]
+    fit_options = {k: v for k, v in options.items() if k != "occupancy"}
+    fit: dict[str, Any] = {"options": fit_options}
+    if options.get("occupancy") is not None:
+        fit["occupancy"] = {"points": int(options["occupancy"])}
     return json.dumps(
         {
             "out": str(out),
             "jobs": 1,
             "format": "glb",
-            "fit": {"options": options},
+            "fit": fit,
             "fit_args": fit_args,
             "version": __version__,
         }
@@ -226,12 +232,18 @@ def main(argv: Optional[list[str]] = None) -> int:
         type=float,
         help="alignment weight of the polish (0: plain polish only, faster; default: both tried on closed meshes)",
     )
+    ap.add_argument(
+        "--occupancy",
+        type=int,
+        metavar="N",
+        help="also write NAME.voronoi.points.npz per mesh: N occupancy samples of the fitted solid (OccNet's layout)",
+    )
     ap.add_argument("--retries", type=int, default=3, help="runs of a task whose worker died (Ray max_retries)")
     ap.add_argument("--cpus-per-task", type=float, default=1.0)
     ap.add_argument("--quiet", action="store_true")
     a = ap.parse_args(argv)
     options = {"sites": a.sites, "seed": a.seed}
-    for k in ("steps", "samples", "eval_samples", "polish_steps", "polish_align"):
+    for k in ("steps", "samples", "eval_samples", "polish_steps", "polish_align", "occupancy"):
         if getattr(a, k) is not None:
             options[k] = getattr(a, k)
     rows = run(a.ray, a.manifest, a.out, options, a.retries, a.cpus_per_task, a.quiet)
