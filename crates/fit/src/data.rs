@@ -31,7 +31,8 @@ pub fn compact(mesh: &TriMesh) -> TriMesh {
 
 /// A labelled pool in the unit cube: `n/2` points uniform in the cube, `n − n/2` near the
 /// surface (`sigmas`: unit-cube lengths, split evenly), labelled by the solid's inside
-/// rule; plus up to 2²⁰ area-uniform surface points with normals (seed XOR
+/// rule (left empty when `solid` is `None`: the caller labels the pool once it has chosen
+/// its solid); plus up to 2²⁰ area-uniform surface points with normals (seed XOR
 /// [`vf_common::rng::seed_tweak::TRAIN_SURFACE`]) for the surface initialisation. Returns
 /// the pool and the number of uniform points (they come first).
 ///
@@ -39,7 +40,7 @@ pub fn compact(mesh: &TriMesh) -> TriMesh {
 /// [`FitError::Occupancy`] from the samplers (invalid sizes).
 pub fn labelled_samples(
     sampler: &SurfaceSampler,
-    solid: &dyn Solid,
+    solid: Option<&dyn Solid>,
     n: usize,
     sigmas: &[f64],
     seed: u64,
@@ -48,7 +49,7 @@ pub fn labelled_samples(
     let mut points = uniform_in_box([0.0; 3], [1.0; 3], n / 2, seed).map_err(fail)?;
     let num_uniform = points.len();
     points.extend(near_surface(sampler, n - n / 2, sigmas, seed).map_err(fail)?);
-    let occupancy = solid.inside(&points);
+    let occupancy = solid.map_or_else(Vec::new, |s| s.inside(&points));
     let surface = sampler.sample(n.min(1 << 20), seed ^ vf_common::rng::seed_tweak::TRAIN_SURFACE);
     Ok((TrainingData { points, occupancy, surface: surface.points, normals: surface.normals }, num_uniform))
 }

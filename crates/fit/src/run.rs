@@ -190,7 +190,13 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
 
     progress.stage(Stage::Sample);
     let diagonal = p.unit.diagonal();
-    let (mut data, num_uniform, train_sigmas) = training_pool(&sampler, &oracle, config, diagonal)?;
+    // Where the flood solid may be chosen, the pool is labelled once the solid is known.
+    let flood_candidate = match config.sampling.solid {
+        SolidRule::Flood => true,
+        SolidRule::Auto => !p.topology.is_closed,
+        _ => false,
+    };
+    let (mut data, num_uniform, train_sigmas) = training_pool(&sampler, &oracle, config, diagonal, !flood_candidate)?;
     let (target, solid_report) = target::choose(
         &oracle,
         &p.unit,
@@ -283,18 +289,21 @@ fn oracle_and_sampler(unit: &TriMesh, name: &str) -> Result<(MeshOracle, Surface
     Ok((oracle, sampler))
 }
 
-/// The training pool labelled by the winding-number solid, where its near-surface part
-/// starts, and its spreads in unit-cube lengths.
+/// The training pool, labelled by the winding-number solid when `label` (else left for
+/// `target::choose`), where its near-surface part starts, and its spreads in unit-cube
+/// lengths.
 fn training_pool(
     sampler: &SurfaceSampler,
     oracle: &MeshOracle,
     config: &FitConfig,
     diagonal: f64,
+    label: bool,
 ) -> Result<(TrainingData, usize, Vec<f64>), FitError> {
     let s = &config.sampling;
     let winding = MeshSolid { oracle };
     let train_sigmas: Vec<f64> = s.sigmas.iter().map(|x| x * diagonal).collect();
-    let (data, num_uniform) = labelled_samples(sampler, &winding, s.samples, &train_sigmas, s.seed)?;
+    let solid: Option<&dyn Solid> = if label { Some(&winding) } else { None };
+    let (data, num_uniform) = labelled_samples(sampler, solid, s.samples, &train_sigmas, s.seed)?;
     Ok((data, num_uniform, train_sigmas))
 }
 
@@ -784,7 +793,8 @@ fn misclassification(
 ) -> Result<QualityReport, FitError> {
     let eval_seed = config.sampling.seed ^ vf_common::rng::seed_tweak::EVALUATION;
     let eval_sigmas: Vec<f64> = config.eval.sigmas.iter().map(|x| x * diagonal).collect();
-    let (eval, num_uniform) = labelled_samples(sampler, solid, config.eval.samples.max(2), &eval_sigmas, eval_seed)?;
+    let (eval, num_uniform) =
+        labelled_samples(sampler, Some(solid), config.eval.samples.max(2), &eval_sigmas, eval_seed)?;
     let predicted = classify(sites, labels, &eval.points);
     let wrong = |r: std::ops::Range<usize>| r.filter(|&i| predicted[i] != eval.occupancy[i]).count();
     let n = eval.points.len();

@@ -6,16 +6,18 @@
 use mesh_io::TriMesh;
 use occupancy::MeshOracle;
 use rayon::prelude::*;
-use soft_voronoi::{FloodSolid, Solid, SurfaceSide, TrainingData};
+use soft_voronoi::{FloodSolid, MeshSolid, Solid, SurfaceSide, TrainingData};
+
+/// Uniform points of the pool on which the flood and winding solids' volumes are compared.
+pub(super) const PROBE: usize = 20_000;
 
 use crate::config::{FLOOD_BOUNDARY_SHARE, FLOOD_DISAGREEMENT};
 use crate::error::FitError;
 use crate::report::FloodReport;
 
-/// The flood solid and its labels of the pool, before it is chosen.
+/// The flood solid and how it sees the pool, before it is chosen.
 pub(super) struct FloodLook<'a> {
     solid: FloodSolid<'a>,
-    labels: Vec<bool>,
     sides: Vec<SurfaceSide>,
     enclosed_share: f64,
     winding_share: f64,
@@ -25,8 +27,11 @@ pub(super) struct FloodLook<'a> {
 /// Builds the flood solid of `unit` (the oracle's mesh) with `cells` cells along the
 /// longest side of its box and sheets of half-thickness `h(share)`, where `share` is the
 /// share of the surface on the solid's boundary or on a sheet (the surface the crust
-/// follows), and labels `data`'s pool and surface samples (uniform points before
-/// `num_uniform`) without changing it.
+/// follows), sorts `data`'s surface samples by side, and compares the solid with the
+/// winding number on probes: the first [`PROBE`] uniform points of the pool (before
+/// `num_uniform`), and the near-surface points from `num_uniform` on whose winding labels
+/// are `winding_near`. `data` is not changed.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn flood_look<'a>(
     oracle: &'a MeshOracle,
     unit: &TriMesh,
@@ -34,11 +39,12 @@ pub(super) fn flood_look<'a>(
     num_uniform: usize,
     cells: usize,
     h: impl Fn(f64) -> f64,
+    winding_near: &[bool],
 ) -> Result<FloodLook<'a>, FitError> {
     let (lo, hi) = oracle.bounding_box();
     let longest = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     let cell = longest / cells.max(1) as f64;
-    let mut solid = FloodSolid::new(oracle, unit, cell, 1.0)
+    let mut solid = FloodSolid::new(oracle, unit, cell, 0.0)
         .map_err(|source| FitError::Occupancy { during: "the flood fill", source })?;
     let sides: Vec<SurfaceSide> = data
         .surface
@@ -46,28 +52,19 @@ pub(super) fn flood_look<'a>(
         .zip(&data.normals)
         .map(|(&x, &n)| if n == [0.0; 3] { SurfaceSide::Crevice } else { solid.surface_side(x, n) })
         .collect();
-    let followed = sides.iter().filter(|&&s| matches!(s, SurfaceSide::Boundary | SurfaceSide::Sheet)).count();
-    let sheet_half_thickness = h(followed as f64 / sides.len().max(1) as f64);
-    solid.sheet_half_thickness = sheet_half_thickness;
-    let labels = solid.inside(&data.points);
     let share = |v: &[bool]| v.iter().filter(|&&b| b).count() as f64 / v.len().max(1) as f64;
-    let u = num_uniform.min(labels.len());
-    let near = labels.len() - u;
-    let disagreement =
-        labels[u..].iter().zip(&data.occupancy[u..]).filter(|(a, b)| a != b).count() as f64 / near.max(1) as f64;
     // The volume the flood solid holds without the sheets' bands (whose thickness is the
     // fit's choice, not the input's): enclosed cells, and the enclosed side of the walls.
-    solid.sheet_half_thickness = 0.0;
-    let enclosed = solid.inside(&data.points[..u]);
-    solid.sheet_half_thickness = sheet_half_thickness;
-    Ok(FloodLook {
-        enclosed_share: share(&enclosed),
-        winding_share: share(&data.occupancy[..u]),
-        solid,
-        labels,
-        sides,
-        disagreement,
-    })
+    let uniform = &data.points[..num_uniform.min(PROBE)];
+    let enclosed_share = share(&solid.inside(uniform));
+    let winding_share = share(&MeshSolid { oracle }.inside(uniform));
+    let followed = sides.iter().filter(|&&s| matches!(s, SurfaceSide::Boundary | SurfaceSide::Sheet)).count();
+    solid.sheet_half_thickness = h(followed as f64 / sides.len().max(1) as f64);
+    let near = &data.points[num_uniform..(num_uniform + winding_near.len()).min(data.points.len())];
+    let flood_near = solid.inside(near);
+    let disagreement =
+        flood_near.iter().zip(winding_near).filter(|(a, b)| a != b).count() as f64 / near.len().max(1) as f64;
+    Ok(FloodLook { solid, sides, enclosed_share, winding_share, disagreement })
 }
 
 impl<'a> FloodLook<'a> {
@@ -99,13 +96,12 @@ impl<'a> FloodLook<'a> {
         }
     }
 
-    /// Takes the flood solid: relabels the pool, leaves interior faces out of the surface
+    /// Takes the flood solid: labels the pool, leaves interior faces out of the surface
     /// samples and moves the sheets' onto their band's two sides (alternately), as the
-    /// shell does. Returns the solid and the report's part.
-    pub(super) fn apply(self, data: &mut TrainingData, scale: f64, diagonal: f64) -> (FloodSolid<'a>, FloodReport) {
-        let report = self.report(scale, diagonal);
+    /// shell does.
+    pub(super) fn apply(self, data: &mut TrainingData) -> FloodSolid<'a> {
         let h = self.solid.sheet_half_thickness;
-        data.occupancy = self.labels;
+        data.occupancy = self.solid.inside(&data.points);
         let (mut surface, mut normals) =
             (Vec::with_capacity(data.surface.len()), Vec::with_capacity(data.normals.len()));
         for (i, ((&x, &n), side)) in data.surface.iter().zip(&data.normals).zip(&self.sides).enumerate() {
@@ -124,6 +120,6 @@ impl<'a> FloodLook<'a> {
             data.surface = surface;
             data.normals = normals;
         }
-        (self.solid, report)
+        self.solid
     }
 }

@@ -75,9 +75,11 @@ impl Target<'_> {
     }
 }
 
-/// Chooses the solid for `data` (labelled by `winding`, near-surface samples from
-/// `num_uniform` on; `is_closed`: the mesh's topology) and, for the shell, relabels the pool and moves its surface points onto
-/// the shell's two sides (alternately). `scale`: input units per unit-cube length.
+/// Chooses the solid for `data` (near-surface samples from `num_uniform` on; labelled by
+/// the winding number, or not yet labelled where the flood solid may be chosen: then it is
+/// labelled here by the solid chosen; `is_closed`: the mesh's topology) and, for the
+/// flood solid and the shell, relabels the pool and moves its sheets' surface points onto
+/// the band's two sides (alternately). `scale`: input units per unit-cube length.
 ///
 /// # Errors
 /// [`FitError::Mesh`] when the winding-number solid is asked for and holds nothing.
@@ -93,15 +95,13 @@ pub(crate) fn choose<'a>(
     scale: f64,
     is_closed: bool,
 ) -> Result<(Target<'a>, SolidReport), FitError> {
-    let near = &data.occupancy[num_uniform..];
-    let share = near.iter().filter(|&&o| o).count() as f64 / near.len().max(1) as f64;
+    let s = &config.sampling;
     let probe = &data.points[num_uniform..data.points.len().min(num_uniform + AMBIGUITY_SAMPLES)];
     let w = oracle
         .winding_numbers(probe, occupancy::WindingMode::Fast)
         .map_err(|source| FitError::Occupancy { during: "winding numbers", source })?;
     let ambiguous = w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64;
-    let s = &config.sampling;
-    let nothing_inside = !data.occupancy.iter().any(|&o| o);
+    let winding_probe: Vec<bool> = w.iter().map(|&w| oracle.config().is_inside_winding(w)).collect();
     let h_sheet = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
     // The flood solid is looked at for every open mesh under auto (a closed mesh's
     // winding number is decisive).
@@ -110,23 +110,26 @@ pub(crate) fn choose<'a>(
         flood_sheet_half_thickness(s.shell_thickness, area, config.train.num_sites, diagonal)
     };
     let flood = match s.solid {
-        SolidRule::Flood => Some(flood_look(oracle, unit, data, num_uniform, s.flood_cells, flood_sheet)?),
-        SolidRule::Auto if !is_closed => Some(flood_look(oracle, unit, data, num_uniform, s.flood_cells, flood_sheet)?),
+        SolidRule::Flood => {
+            Some(flood_look(oracle, unit, data, num_uniform, s.flood_cells, flood_sheet, &winding_probe)?)
+        }
+        SolidRule::Auto if !is_closed => {
+            Some(flood_look(oracle, unit, data, num_uniform, s.flood_cells, flood_sheet, &winding_probe)?)
+        }
         _ => None,
     };
-    let (rule, chosen_by) = match s.solid {
-        SolidRule::Auto if flood.as_ref().is_some_and(|f| f.wanted()) => (SolidRule::Flood, "auto"),
-        SolidRule::Auto if !is_closed && (ambiguous >= SHELL_ABOVE || nothing_inside) => (SolidRule::Shell, "auto"),
-        SolidRule::Auto => (SolidRule::Winding, "auto"),
-        r => (r, "--solid"),
-    };
     let flood_report = |f: &FloodLook| f.report(scale, diagonal);
-    if rule == SolidRule::Flood {
-        let f = flood.ok_or(FitError::Internal("the flood solid was not built"))?;
+    let by_flood = match s.solid {
+        SolidRule::Flood => Some("--solid"),
+        SolidRule::Auto if flood.as_ref().is_some_and(|f| f.wanted()) => Some("auto"),
+        _ => None,
+    };
+    if let (Some(chosen_by), Some(f)) = (by_flood, flood.as_ref()) {
+        let probe_share = winding_probe.iter().filter(|&&o| o).count() as f64 / winding_probe.len().max(1) as f64;
         let report = SolidReport {
-            rule,
+            rule: SolidRule::Flood,
             chosen_by,
-            near_surface_inside_share: share,
+            near_surface_inside_share: probe_share,
             near_surface_ambiguous_share: ambiguous,
             half_thickness: None,
             half_thickness_of_diagonal: None,
@@ -135,14 +138,26 @@ pub(crate) fn choose<'a>(
             interior_surface_samples_dropped: 0,
             cap_samples: 0,
             thickness_search: None,
-            flood: None,
+            flood: Some(flood_report(f)),
         };
-        let (solid, flood) = f.apply(data, scale, diagonal);
+        let solid = flood.ok_or(FitError::Internal("the flood solid was not built"))?.apply(data);
         if !data.occupancy.iter().any(|&o| o) {
             return Err(FitError::Mesh { mesh: s.mesh.clone(), fault: MeshFault::NothingInside });
         }
-        return Ok((Target::Flood(solid), SolidReport { flood: Some(flood), ..report }));
+        return Ok((Target::Flood(solid), report));
     }
+    // The pool was left unlabelled where the flood solid might have been chosen.
+    if data.occupancy.len() != data.points.len() {
+        data.occupancy = MeshSolid { oracle }.inside(&data.points);
+    }
+    let near = &data.occupancy[num_uniform..];
+    let share = near.iter().filter(|&&o| o).count() as f64 / near.len().max(1) as f64;
+    let nothing_inside = !data.occupancy.iter().any(|&o| o);
+    let (rule, chosen_by) = match s.solid {
+        SolidRule::Auto if !is_closed && (ambiguous >= SHELL_ABOVE || nothing_inside) => (SolidRule::Shell, "auto"),
+        SolidRule::Auto => (SolidRule::Winding, "auto"),
+        r => (r, "--solid"),
+    };
     if rule == SolidRule::Winding {
         if nothing_inside {
             return Err(FitError::Mesh { mesh: s.mesh.clone(), fault: MeshFault::NothingInside });
