@@ -78,6 +78,15 @@ fn the_flood_solid_keeps_every_part_of_a_soup() {
     // are sheets.
     assert!(f.boundary_share > 0.3 && f.sheet_share > 0.2, "{f:?}");
     assert!(out.report.summary().contains("flood fill"), "{}", out.report.summary());
+    // The sheets' band against the F-score's τ: at K = 2,048 it is wider, and the report
+    // says about how many sites would bring it within τ (K scaled by (h/τ)²).
+    let b = s.sheet_band.as_ref().expect("a flood solid with sheets reports its band");
+    assert!(!b.within_tau && b.half_thickness_of_diagonal > b.tau_of_diagonal, "{b:?}");
+    let k = b.sites_for_tau.unwrap() as f64;
+    let expected = 2048.0 * (b.half_thickness_of_diagonal / b.tau_of_diagonal).powi(2);
+    assert!((k - expected).abs() <= 1.0, "{b:?}");
+    assert!(out.report.details().contains("would bring them within τ"), "{}", out.report.details());
+    assert!(out.report.summary().lines().all(|l| l.chars().count() <= 100), "{}", out.report.summary());
     let c = &out.report.crust;
     assert!(c.is_closed && c.is_manifold, "{c:?}");
     let h = f.sheet_half_thickness_of_diagonal;

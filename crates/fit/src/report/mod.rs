@@ -9,7 +9,7 @@ mod stages;
 mod summary;
 
 pub use stages::{
-    AccuracyReport, BandTrial, CarveReport, FloodReport, GrowthRow, GuardReport, SolidReport, SurfaceBar,
+    AccuracyReport, BandTrial, CarveReport, FloodReport, GrowthRow, GuardReport, SheetBand, SolidReport, SurfaceBar,
     CHOSEN_AFTER_EMPTY_WINDING,
 };
 pub use summary::{SHELL_HINT_ABOVE, SUMMARY_LINES};

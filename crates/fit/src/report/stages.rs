@@ -47,7 +47,45 @@ pub struct SolidReport {
     /// look at it on an open mesh).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub flood: Option<FloodReport>,
+    /// Whether a band's two sides (the shell's, the flood solid's sheets') lie within the
+    /// F-score's τ of the sheet, and if not, about how many sites would put them there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sheet_band: Option<SheetBand>,
 }
+
+/// A sheet's band against the F-score's τ (report field `solid.sheet_band`): the band's
+/// sides stand its half-thickness h off the sheet, so both lie within τ when h ≤ τ. h
+/// scales as √(A/K) (`config::shell_half_thickness`), so about K·(h/τ)² sites bring it
+/// there.
+#[derive(Clone, Debug, Serialize)]
+pub struct SheetBand {
+    /// The band's half-thickness as a share of the diagonal.
+    pub half_thickness_of_diagonal: f64,
+    /// The F-score's τ as a share of the diagonal.
+    pub tau_of_diagonal: f64,
+    /// Whether both sides lie within τ of the sheet.
+    pub within_tau: bool,
+    /// About how many sites would bring them within τ (when they are not).
+    pub sites_for_tau: Option<usize>,
+}
+
+impl SheetBand {
+    /// The band of half-thickness `h_of_diagonal` fitted with `num_sites` sites.
+    pub fn of(h_of_diagonal: f64, num_sites: usize) -> Self {
+        let tau = SHEET_TAU;
+        let within = h_of_diagonal <= tau;
+        let sites = (num_sites as f64 * (h_of_diagonal / tau).powi(2)).ceil() as usize;
+        SheetBand {
+            half_thickness_of_diagonal: h_of_diagonal,
+            tau_of_diagonal: tau,
+            within_tau: within,
+            sites_for_tau: (!within).then_some(sites),
+        }
+    }
+}
+
+/// The F-score's τ as a share of the diagonal (`metrics::SurfaceOptions`' default).
+pub const SHEET_TAU: f64 = 0.003;
 
 /// The flood solid's grid and which rule made which part of the surface (report field
 /// `solid.flood`). Shares are of the area-uniform surface samples.

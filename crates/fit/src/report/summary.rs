@@ -49,7 +49,7 @@ impl FitReport {
         let polished = self.polish_sentence();
         let carved = format!("{}{}", self.carving_sentence(), self.guard_sentence());
         let pruned = self.pruning_sentence();
-        let shell = format!("{}{}", self.shell_sentence(), self.flood_sentence());
+        let shell = format!("{}{}{}", self.shell_sentence(), self.flood_sentence(), self.sheet_band_sentence());
         let metrics = self.metrics_sentence();
         let target = self.accuracy_sentence();
         format!(
@@ -100,6 +100,21 @@ impl FitReport {
         format!("{}: {} sites{kept}, {} steps, preset {}", self.input.path, t.num_sites, t.steps, self.settings.preset)
     }
 
+    /// The sites a sheet's band would need to lie within the F-score's τ, when it does not
+    /// (a sentence of `details()`).
+    fn sheet_band_sentence(&self) -> String {
+        match &self.solid.sheet_band {
+            Some(b) if !b.within_tau => format!(
+                " The band's sides stand {:.2}% of the diagonal off the sheet, beyond the F-score's τ = {:.1}%; its \
+                 half-thickness scales as 1/√K, so about {} sites would bring them within τ.",
+                100.0 * b.half_thickness_of_diagonal,
+                100.0 * b.tau_of_diagonal,
+                vf_common::text::group(b.sites_for_tau.unwrap_or(0))
+            ),
+            _ => String::new(),
+        }
+    }
+
     /// Line 2: the solid the sites fit.
     fn solid_line(&self) -> String {
         let s = &self.solid;
@@ -110,8 +125,7 @@ impl FitReport {
         };
         if let (SolidRule::Flood, Some(f)) = (s.rule, &s.flood) {
             return format!(
-                "Solid: flood fill from outside ({by}): {:.0}% of the surface bounds closed parts, {:.0}% are sheets \
-                 thickened ±{:.2}%, {:.0}% interior faces left out",
+                "Solid: flood fill, {by}: {:.0}% closed parts, {:.0}% sheets ±{:.2}%, {:.0}% inner faces dropped",
                 100.0 * f.boundary_share,
                 100.0 * f.sheet_share,
                 100.0 * f.sheet_half_thickness_of_diagonal,

@@ -68,6 +68,16 @@ pub(super) fn flood_look<'a>(
 }
 
 impl<'a> FloodLook<'a> {
+    /// Share of the surface samples on sheets.
+    pub(super) fn sheet_share(&self) -> f64 {
+        self.sides.iter().filter(|&&s| s == SurfaceSide::Sheet).count() as f64 / self.sides.len().max(1) as f64
+    }
+
+    /// The sheets' half-thickness, unit-cube lengths.
+    pub(super) fn sheet_half_thickness(&self) -> f64 {
+        self.solid.sheet_half_thickness
+    }
+
     /// The auto rule's test ([`FLOOD_BOUNDARY_SHARE`]).
     pub(super) fn wanted(&self) -> bool {
         let boundary = self.sides.iter().filter(|&&s| s == SurfaceSide::Boundary).count();

@@ -21,7 +21,11 @@ use crate::config::{
     flood_sheet_half_thickness, shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE,
 };
 use crate::error::{FitError, MeshFault};
-pub use crate::report::{BandTrial, FloodReport, SolidReport};
+pub use crate::report::{BandTrial, FloodReport, SheetBand, SolidReport};
+
+/// The flood solid's report has a `sheet_band` when more than this share of the surface
+/// is sheets.
+const SHEET_BAND_MIN_SHARE: f64 = 0.01;
 pub use band::BAND_FACTORS;
 use band::*;
 pub use caps::cap_samples;
@@ -139,6 +143,8 @@ pub(crate) fn choose<'a>(
             cap_samples: 0,
             thickness_search: None,
             flood: Some(flood_report(f)),
+            sheet_band: (f.sheet_share() > SHEET_BAND_MIN_SHARE)
+                .then(|| SheetBand::of(f.sheet_half_thickness() / diagonal, config.train.num_sites)),
         };
         let solid = flood.ok_or(FitError::Internal("the flood solid was not built"))?.apply(data);
         if !data.occupancy.iter().any(|&o| o) {
@@ -190,6 +196,7 @@ pub(crate) fn choose<'a>(
             cap_samples: caps,
             thickness_search: None,
             flood: flood.as_ref().map(flood_report),
+            sheet_band: None,
         };
         return Ok((Target::Winding(solid), report));
     }
@@ -241,6 +248,7 @@ pub(crate) fn choose<'a>(
         cap_samples: 0,
         thickness_search,
         flood: flood.as_ref().map(flood_report),
+        sheet_band: Some(SheetBand::of(h / diagonal, config.train.num_sites)),
     };
     Ok((Target::Shell(solid, sites, labels), report))
 }
