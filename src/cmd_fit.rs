@@ -123,7 +123,7 @@ pub struct Args {
     /// the full spacing (the report's `solid.thickness_search`).
     #[arg(long, value_parser = parse_share)]
     pub shell_thickness: Option<f64>,
-    /// Cells of the flood fill's grid along the longest side of the mesh (16 to 1024,
+    /// Cells of the flood fill's grid along the longest side of the mesh (16 to 500,
     /// default 256); gaps narrower than about 2.7 cells are closed.
     #[arg(long)]
     pub flood_cells: Option<usize>,

@@ -95,8 +95,8 @@ impl FitOptions {
         c.sampling.solid = self.solid;
         c.sampling.shell_thickness = self.shell_thickness;
         if let Some(n) = self.flood_cells {
-            if !(16..=1024).contains(&n) {
-                return Err(FitError::Settings(format!("--flood-cells {n}: use 16 to 1024")));
+            if !(16..=500).contains(&n) {
+                return Err(FitError::Settings(format!("--flood-cells {n}: use 16 to 500")));
             }
             c.sampling.flood_cells = n;
         }

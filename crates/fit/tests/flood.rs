@@ -125,3 +125,14 @@ fn a_closed_mesh_keeps_the_winding_solid_and_flood_can_be_forced() {
     assert!(f.disagreement < 1e-3 && (0.0..0.03).contains(&(f.winding_share - f.enclosed_share)), "{f:?}");
     assert!(out.report.crust.is_closed);
 }
+
+#[test]
+fn a_flood_grid_out_of_range_is_refused_before_any_work() {
+    for n in [0, 15, 501, 100_000] {
+        let o = fit::FitOptions { flood_cells: Some(n), ..Default::default() };
+        let e = o.to_config("m").unwrap_err();
+        assert!(e.is_input_fault() && e.to_string().contains("--flood-cells"), "{e}");
+    }
+    let o = fit::FitOptions { flood_cells: Some(64), ..Default::default() };
+    assert_eq!(o.to_config("m").unwrap().sampling.flood_cells, 64);
+}
