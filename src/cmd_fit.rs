@@ -120,6 +120,12 @@ pub struct Args {
     /// the full spacing (the report's `solid.thickness_search`).
     #[arg(long, value_parser = parse_share)]
     pub shell_thickness: Option<f64>,
+    /// Keep an open mesh's planar holes open. By default, before the winding-number solid
+    /// is built, each hole whose rim lies in a plane (within 1% of its size) is closed flat
+    /// where that closes a piece with real volume (a cube without its bottom gets its
+    /// bottom); other holes are closed by the |winding number| = 0.5 surface.
+    #[arg(long)]
+    pub no_fill_holes: bool,
     /// Ask for an accuracy instead of a K: the certified Hausdorff distance to the input as
     /// a share of its bounding-box diagonal (`0.5%` or `0.005`). The fit starts at --sites
     /// and doubles K, refining where the error was, until met or --max-sites.
@@ -220,6 +226,7 @@ impl Args {
                 eval_samples: Some(self.eval_samples),
                 solid: self.solid,
                 shell_thickness: self.shell_thickness,
+                no_fill_holes: self.no_fill_holes,
                 no_relabel: self.no_relabel,
                 carve: self.carve,
                 no_carve: self.no_carve,

@@ -56,6 +56,11 @@ pub struct Sampling {
     /// whose crust holds, see `target::thinnest_band`).
     #[serde(default)]
     pub shell_thickness: Option<f64>,
+    /// Close the input's planar holes flat before the winding-number solid is built
+    /// (`mesh_io::fill_planar_holes`; not for a thin shell). Absent in checkpoints written
+    /// before it existed: off, as they were sampled.
+    #[serde(default)]
+    pub fill_holes: bool,
 }
 
 /// Which solid a mesh stands for.
@@ -188,6 +193,7 @@ impl FitConfig {
                 margin: MARGIN,
                 solid: SolidRule::Auto,
                 shell_thickness: None,
+                fill_holes: true,
             },
             eval: EvalSampling { samples: DEFAULT_EVAL_SAMPLES, sigmas: vec![0.01] },
             checkpointing: None,

@@ -51,6 +51,9 @@ pub struct FitOptions {
     pub solid: SolidRule,
     /// Shell thickness as a fraction of the diagonal.
     pub shell_thickness: Option<f64>,
+    /// Keep an open mesh's planar holes open (default: closed flat before the
+    /// winding-number solid is built, `mesh_io::fill_planar_holes`).
+    pub no_fill_holes: bool,
     /// Keep the training labels.
     pub no_relabel: bool,
     /// Carving tolerance as a fraction of the diagonal (default 0.3%).
@@ -91,6 +94,7 @@ impl FitOptions {
         c.sampling.samples = self.samples.unwrap_or(c.sampling.samples);
         c.sampling.solid = self.solid;
         c.sampling.shell_thickness = self.shell_thickness;
+        c.sampling.fill_holes = !self.no_fill_holes;
         c.train_shell = self.steps.is_some();
         // The paper preset is the paper's method: no polish, no relabelling, no insertion.
         c.relabel = !self.no_relabel && !paper;

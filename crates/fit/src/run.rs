@@ -34,11 +34,21 @@ pub struct FitOutput {
 
 /// The mesh in the unit cube and what is built on it.
 struct Prepared {
+    /// The input without unreferenced vertices (the metrics' reference).
     mesh: TriMesh,
     transform: UnitCubeTransform,
+    /// The solid's surface in the unit cube: the input consistently oriented, with its
+    /// planar holes closed when they were filled.
     unit: TriMesh,
+    /// The input's topology.
     topology: TopologyReport,
     reoriented: mesh_io::Reorientation,
+    /// The holes closed flat (open input, filling asked for and not a thin shell).
+    holes: Option<mesh_io::HoleFilling>,
+    /// Whether `unit` is closed: the input is, or its fills closed it. A mesh closed by its
+    /// fills is fitted as a closed one: the winding-number solid without caps, and both
+    /// polishes tried.
+    closed: bool,
 }
 
 fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
@@ -55,7 +65,23 @@ fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
     // stay as given.
     let (unit, reoriented) = mesh_io::orient_consistently(&transform.mesh_to_unit(&mesh));
     let topology = TopologyReport::of(&mesh);
-    Ok(Prepared { mesh, transform, unit, topology, reoriented })
+    // Holes closed the way a person would: a planar rim by its flat lid, before the
+    // winding numbers are computed, so that the lid is the solid's surface (the |w| = 0.5
+    // cap of a cube without its bottom bulges deep into the box). Not for a thin shell,
+    // whose surface is the input as it is; `fill_planar_holes` leaves a sheet's own
+    // outline open by itself.
+    let fill = config.sampling.fill_holes && config.sampling.solid != SolidRule::Shell && !topology.is_closed;
+    let (unit, holes) = if fill {
+        let (filled, mut r) = mesh_io::fill_planar_holes(&unit, &mesh_io::FillOptions::default());
+        // Unit-cube areas back to the input's units (`scale`: unit-cube lengths per input unit).
+        r.filled_area /= transform.scale * transform.scale;
+        (filled, Some(r))
+    } else {
+        (unit, None)
+    };
+    let closed =
+        topology.is_closed || holes.as_ref().is_some_and(|h| h.loops_filled > 0 && TopologyReport::of(&unit).is_closed);
+    Ok(Prepared { mesh, transform, unit, topology, reoriented, holes, closed })
 }
 
 /// Everything from the polish on: the sites and the checked crust built from them, with the
@@ -163,11 +189,11 @@ impl Clock {
 /// spacing leaves no site inside after training (an empty crust); the fit then runs again
 /// as a thin shell around the surface, and the report's `solid.chosen_by` says so.
 pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
-    match fit_once(input, config, progress) {
+    match fit_holes(input, config, progress) {
         Err(FitError::Mesh { fault: MeshFault::NoSiteInside, .. }) if config.sampling.solid == SolidRule::Auto => {
             let mut shell = config.clone();
             shell.sampling.solid = SolidRule::Shell;
-            let mut out = fit_once(input, &shell, progress)?;
+            let mut out = fit_holes(input, &shell, progress)?;
             out.report.solid.chosen_by = CHOSEN_AFTER_EMPTY_WINDING;
             Ok(out)
         }
@@ -175,8 +201,22 @@ pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> 
     }
 }
 
-/// One fit with the solid rule as configured ([`fit`] adds the fallback to a thin shell).
-fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
+/// One fit with the solid rule as configured, the input's planar holes filled as
+/// configured; should `--solid auto` take a thin shell for the filled mesh (still open and
+/// a sheet beside most of its surface), the fit starts again without the fills: a thin
+/// shell's surface is the input as it is.
+fn fit_holes(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
+    if let Some(out) = fit_once(input, config, progress)? {
+        return Ok(out);
+    }
+    let mut open = config.clone();
+    open.sampling.fill_holes = false;
+    fit_once(input, &open, progress)?.ok_or(FitError::Internal("a fit without fills asked to run again without them"))
+}
+
+/// One fit with the solid rule as configured ([`fit`] adds the fallback to a thin shell);
+/// `None` when a thin shell was chosen for a mesh whose holes were filled ([`fit_holes`]).
+fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<Option<FitOutput>, FitError> {
     let t_all = Instant::now();
     config.validate()?;
     let mut clock = Clock::new();
@@ -200,8 +240,14 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
         config,
         diagonal,
         p.transform.scale,
-        p.topology.is_closed,
+        p.closed,
     )?;
+    let filled = p.holes.as_ref().is_some_and(|h| h.loops_filled > 0);
+    if filled && target.places_sites() {
+        return Ok(None);
+    }
+    let mut solid_report = solid_report;
+    solid_report.holes_filled = p.holes.clone();
     clock.timings.sample = clock.lap();
     // A thin shell's sites are kept as constructed unless asked for (`train_shell`).
     let untrained;
@@ -269,7 +315,7 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
         total_seconds: t_all.elapsed().as_secs_f64(),
     };
     let sites = SitesFile { sites, inside: labels, transform: p.transform.from_unit_matrix() };
-    Ok(FitOutput { sites, crust: crust_mesh, state, report })
+    Ok(Some(FitOutput { sites, crust: crust_mesh, state, report }))
 }
 
 /// The occupancy oracle and the surface sampler of the mesh in the unit cube (`name` for
@@ -369,7 +415,7 @@ impl AfterTraining<'_> {
             && !forced
             && config.polish.is_some()
             && !self.target.places_sites()
-            && self.p.topology.is_closed;
+            && self.p.closed;
         // No gate is passed here, so every attempt below ends with a crust.
         let done = |a: Result<Attempt, SurfaceBar>| a.map_err(|_| FitError::Internal("carving stopped without a gate"));
         let plain = if forced {

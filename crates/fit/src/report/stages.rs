@@ -43,6 +43,13 @@ pub struct SolidReport {
     /// The thinner bands tried before settling on the shell's half-thickness (shell with
     /// the default thickness and sites kept as constructed only; see `target::thinnest_band`).
     pub thickness_search: Option<Vec<BandTrial>>,
+    /// The open input's holes closed flat before the solid was built
+    /// ([`mesh_io::fill_planar_holes`]; areas in input units squared): winding solid of an
+    /// open input only, absent otherwise. The filled mesh is the solid's surface: the
+    /// winding numbers, the surface samples and the caps (over the holes left open) are
+    /// those of the input with its fills; the metrics stay against the input as given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holes_filled: Option<mesh_io::HoleFilling>,
 }
 
 /// One band tried by `target::thinnest_band`: its half-thickness, the crust's topology and its

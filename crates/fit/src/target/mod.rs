@@ -115,6 +115,7 @@ pub(crate) fn choose<'a>(
             interior_surface_samples_dropped: dropped,
             cap_samples: caps,
             thickness_search: None,
+            holes_filled: None,
         };
         return Ok((Target::Winding(solid), report));
     }
@@ -165,6 +166,7 @@ pub(crate) fn choose<'a>(
         interior_surface_samples_dropped: 0,
         cap_samples: 0,
         thickness_search,
+        holes_filled: None,
     };
     Ok((Target::Shell(solid, sites, labels), report))
 }

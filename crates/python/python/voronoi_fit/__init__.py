@@ -65,6 +65,7 @@ _FIT_OPTIONS = {
     "eval_samples",
     "solid",
     "shell_thickness",
+    "no_fill_holes",
     "skip_metrics",
     "polish_steps",
     "polish_lr",
@@ -329,7 +330,8 @@ def fit(
         **options: the CLI's other fit options by their long names: steps, preset
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
-            solid ("auto" | "winding" | "shell"), shell_thickness, skip_metrics,
+            solid ("auto" | "winding" | "shell"), shell_thickness, no_fill_holes (keep
+            planar holes open), skip_metrics,
             polish_steps (0: no polish), polish_lr, polish_align (None: on a closed mesh both
             polishes, the aligned crust kept where it is at least as good on all four metrics,
             Hausdorff distances both within the F-score's tau or with overlapping certified
