@@ -10,7 +10,7 @@ use occupancy::MeshOracle;
 use soft_voronoi::{checkpoint, classify, MeshSolid, Solid, TrainState, Trainer, TrainingData};
 
 use crate::carve::SurfaceBar;
-use crate::config::{FitConfig, SolidRule};
+use crate::config::{FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE};
 use crate::crust_step::{crust_of, CheckedCrust};
 use crate::data::{compact, labelled_samples};
 use crate::error::{FitError, MeshFault};
@@ -67,21 +67,44 @@ fn prepare(input: &TriMesh, config: &FitConfig) -> Result<Prepared, FitError> {
     let topology = TopologyReport::of(&mesh);
     // Holes closed the way a person would: a planar rim by its flat lid, before the
     // winding numbers are computed, so that the lid is the solid's surface (the |w| = 0.5
-    // cap of a cube without its bottom bulges deep into the box). Not for a thin shell,
-    // whose surface is the input as it is; `fill_planar_holes` leaves a sheet's own
-    // outline open by itself.
+    // cap is sampled, and bends where several holes are open). Not for a thin shell, whose
+    // surface is the input as it is: not under `--solid shell`, nor under `--solid auto` for
+    // an open mesh that is a sheet as it is ([`open_mesh_is_a_sheet`]); `fill_planar_holes`
+    // leaves a sheet's own outline open by itself.
     let fill = config.sampling.fill_holes && config.sampling.solid != SolidRule::Shell && !topology.is_closed;
     let (unit, holes) = if fill {
         let (filled, mut r) = mesh_io::fill_planar_holes(&unit, &mesh_io::FillOptions::default());
         // Unit-cube areas back to the input's units (`scale`: unit-cube lengths per input unit).
         r.filled_area /= transform.scale * transform.scale;
-        (filled, Some(r))
+        if r.loops_filled > 0 && config.sampling.solid == SolidRule::Auto && open_mesh_is_a_sheet(&unit, config)? {
+            (unit, None)
+        } else {
+            (filled, Some(r))
+        }
     } else {
         (unit, None)
     };
     let closed =
         topology.is_closed || holes.as_ref().is_some_and(|h| h.loops_filled > 0 && TopologyReport::of(&unit).is_closed);
     Ok(Prepared { mesh, transform, unit, topology, reoriented, holes, closed })
+}
+
+/// Whether `--solid auto` takes a thin shell for the open `unit` as it is: its winding number
+/// ambiguous beside most of its surface, judged on [`AMBIGUITY_SAMPLES`] near-surface points
+/// as `target::choose` judges the pool's. Such a mesh is a sheet and keeps its holes: closing
+/// some of them could tip the rule to the winding solid of a sheet (the real-world
+/// benchmark's car body with its windows closed: a volume with caps under it, 16.7% of the
+/// diagonal from the input, against 1.3% as a shell). Costs an oracle of the open mesh
+/// (0.1 s on that car body) and winding numbers at the probe points.
+fn open_mesh_is_a_sheet(unit: &TriMesh, config: &FitConfig) -> Result<bool, FitError> {
+    let (oracle, sampler) = oracle_and_sampler(unit, &config.sampling.mesh)?;
+    let sigmas: Vec<f64> = config.sampling.sigmas.iter().map(|x| x * unit.diagonal()).collect();
+    let probe = occupancy::sample::near_surface(&sampler, AMBIGUITY_SAMPLES, &sigmas, config.sampling.seed)
+        .map_err(|source| FitError::Occupancy { during: "sampling", source })?;
+    let w = oracle
+        .winding_numbers(&probe, occupancy::WindingMode::Fast)
+        .map_err(|source| FitError::Occupancy { during: "winding numbers", source })?;
+    Ok(target::ambiguous_share(&w) >= SHELL_ABOVE)
 }
 
 /// Everything from the polish on: the sites and the checked crust built from them, with the

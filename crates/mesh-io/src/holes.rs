@@ -27,6 +27,8 @@
 //! - The fill must close a piece with real volume ([`MIN_FILL_DEPTH`]): a flat patch's
 //!   only loop is its own outline, planar and simple, and filling it would double the
 //!   sheet; a soup's triangles are each their own planar loop.
+//! - The fill must lie on the boundary of the solid it closes, where the open mesh's
+//!   winding number is about ½ ([`LID_WINDING`]), not inside it or outside it.
 //!
 //! Positions are untouched and the input's triangles come first, in order; the fills are
 //! appended.
@@ -95,6 +97,9 @@ pub struct HoleFilling {
     pub open_shallow: usize,
     /// Loops left open because they have fewer than 3 vertices or no area.
     pub open_degenerate: usize,
+    /// Loops left open because their lid would lie inside or outside the solid it closes,
+    /// not on its boundary ([`LID_WINDING`]).
+    pub open_not_on_boundary: usize,
     /// Loops left open because their piece (component) also has boundary edges on no
     /// loop: its volume, and so the fill's depth, is not defined.
     pub open_in_tangled_piece: usize,
@@ -160,6 +165,8 @@ pub fn fill_planar_holes(mesh: &TriMesh, opts: &FillOptions) -> (TriMesh, HoleFi
     for (l, f) in loops.iter().zip(&fans) {
         *volume.entry(dsu.find(l[0])).or_insert(0.0) += f;
     }
+    // Lids that pass every test but the last, with their area.
+    let mut candidates: Vec<(Vec<[u32; 3]>, f64)> = Vec::new();
     for (l, fan) in loops.iter().zip(&fans) {
         if tangled.contains(&dsu.find(l[0])) {
             report.open_in_tangled_piece += 1;
@@ -180,14 +187,77 @@ pub fn fill_planar_holes(mesh: &TriMesh, opts: &FillOptions) -> (TriMesh, HoleFi
                     report.open_shallow += 1;
                     continue;
                 }
-                report.loops_filled += 1;
-                report.filled_area += area;
-                report.triangles_added += tris.len();
-                out.triangles.extend(tris);
+                candidates.push((tris, area));
             }
         }
     }
+    // The lids' probe points: the centroids of each lid's largest triangles.
+    let probes: Vec<Vec<[f64; 3]>> = candidates
+        .iter()
+        .map(|(tris, _)| {
+            let mut by_area: Vec<&[u32; 3]> = tris.iter().collect();
+            by_area.sort_by(|a, b| triangle_area(p, b).total_cmp(&triangle_area(p, a)));
+            let m = (LID_PROBES_BUDGET / welded.len().max(1)).clamp(1, LID_PROBES);
+            by_area.iter().take(m).map(|t| centroid(p, &t[..])).collect()
+        })
+        .collect();
+    let flat: Vec<[f64; 3]> = probes.iter().flatten().copied().collect();
+    let w = winding_numbers(p, &welded, &flat);
+    let mut at = 0;
+    for ((tris, area), probe) in candidates.into_iter().zip(&probes) {
+        let mean = w[at..at + probe.len()].iter().map(|w| w.abs()).sum::<f64>() / probe.len() as f64;
+        at += probe.len();
+        if !(LID_WINDING.0..=LID_WINDING.1).contains(&mean) {
+            report.open_not_on_boundary += 1;
+            continue;
+        }
+        report.loops_filled += 1;
+        report.filled_area += area;
+        report.triangles_added += tris.len();
+        out.triangles.extend(tris);
+    }
     (out, report)
+}
+
+/// The open mesh's |winding number| at a lid's points must lie in this range (mean over
+/// up to [`LID_PROBES`] points) for the lid to be made. On the plane of a lid the lid itself
+/// adds nothing, so there the open mesh's winding number is the mean of the filled mesh's
+/// on the lid's two sides: ½ where the lid is the boundary of the solid it closes (a single
+/// planar hole in an otherwise closed surface: exactly ½; an open pipe's ends, each pulled
+/// by the other's hole: 0.45), near 1 or 0 where it would lie inside the solid or outside
+/// it (a tube's open top just under the lid of a wider hole around it: libigl's halftunnel,
+/// whose post's top, filled, gave the crust a sliver and genus 19 instead of 1).
+pub const LID_WINDING: (f64, f64) = (0.3, 0.7);
+
+/// Points of a lid at which [`LID_WINDING`] is checked.
+pub const LID_PROBES: usize = 8;
+
+/// Bound on triangles × points of the lids' winding numbers (by direct summation): a mesh
+/// of more than this over [`LID_PROBES`] triangles checks fewer points per lid, one at least.
+pub const LID_PROBES_BUDGET: usize = 1 << 26;
+
+/// The generalized winding number of `triangles` at each of `points`, by direct summation
+/// of the triangles' signed solid angles (Van Oosterom and Strackee).
+fn winding_numbers(p: &[[f64; 3]], triangles: &[[u32; 3]], points: &[[f64; 3]]) -> Vec<f64> {
+    points
+        .iter()
+        .map(|q| {
+            let mut total = 0.0;
+            for t in triangles {
+                let [a, b, c] = t.map(|v| {
+                    let x = p[v as usize];
+                    [x[0] - q[0], x[1] - q[1], x[2] - q[2]]
+                });
+                let (la, lb, lc) = (norm(a), norm(b), norm(c));
+                let det = a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]);
+                let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+                let den = la * lb * lc + dot(a, b) * lc + dot(b, c) * la + dot(c, a) * lb;
+                total += 2.0 * det.atan2(den);
+            }
+            total / (4.0 * std::f64::consts::PI)
+        })
+        .collect()
 }
 
 /// Each vertex's representative: the first vertex at the same position (−0 and +0 equal,
@@ -744,6 +814,27 @@ mod tests {
         assert!((r.filled_area - 2.0 * half_disc).abs() < 1e-9, "{r:?}");
         let t = closed_and_oriented(&filled);
         assert!((t.signed_volume + 2.0 * half_disc).abs() < 1e-9, "inside out, as given: {t:?}");
+    }
+
+    #[test]
+    fn a_lid_inside_the_solid_is_not_made() {
+        // A cube without its bottom inside a closed box: its lid would lie inside the box's
+        // solid (the open mesh's winding number there is 1.5), an interior face.
+        let outer = cuboid([-1.0; 3], [2.0; 3]);
+        let inner = cuboid([0.0; 3], [1.0; 3]);
+        let n = outer.positions.len() as u32;
+        let m = TriMesh {
+            positions: outer.positions.iter().chain(&inner.positions).copied().collect(),
+            triangles: outer
+                .triangles
+                .iter()
+                .copied()
+                .chain(inner.triangles[2..].iter().map(|t| t.map(|v| v + n)))
+                .collect(),
+        };
+        let (same, r) = fill_planar_holes(&m, &FillOptions::default());
+        assert_eq!((r.loops_found, r.loops_filled, r.open_not_on_boundary), (1, 0, 1), "{r:?}");
+        assert_eq!(same, m);
     }
 
     #[test]

@@ -341,6 +341,7 @@ impl FitReport {
             (h.open_not_simple, "rim crossing itself in its plane"),
             (h.open_shallow, "the fill would enclose no real volume, as a sheet's outline"),
             (h.open_degenerate, "no area"),
+            (h.open_not_on_boundary, "the lid would lie inside or outside the solid, not on its boundary"),
             (h.open_in_tangled_piece, "on a piece whose other open edges form no loop"),
         ] {
             if n > 0 {

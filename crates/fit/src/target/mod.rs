@@ -76,7 +76,7 @@ pub(crate) fn choose<'a>(
     let w = oracle
         .winding_numbers(probe, occupancy::WindingMode::Fast)
         .map_err(|source| FitError::Occupancy { during: "winding numbers", source })?;
-    let ambiguous = w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64;
+    let ambiguous = ambiguous_share(&w);
     let s = &config.sampling;
     let nothing_inside = !data.occupancy.iter().any(|&o| o);
     let (shell, chosen_by) = match s.solid {
@@ -169,6 +169,11 @@ pub(crate) fn choose<'a>(
         holes_filled: None,
     };
     Ok((Target::Shell(solid, sites, labels), report))
+}
+
+/// Share of winding numbers with 0.25 < |w| < 0.75 ([`SHELL_ABOVE`]).
+pub(crate) fn ambiguous_share(w: &[f64]) -> f64 {
+    w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64
 }
 
 #[cfg(test)]
