@@ -211,6 +211,10 @@ impl Clock {
 /// Under `--solid auto`, a winding-number solid whose parts are all thinner than the sites'
 /// spacing leaves no site inside after training (an empty crust); the fit then runs again
 /// as a thin shell around the surface, and the report's `solid.chosen_by` says so.
+///
+/// With `config.sampling.fill_holes` (the default), an open input's planar holes are closed
+/// flat before the winding-number solid is built ([`mesh_io::fill_planar_holes`]; the
+/// report's `solid.holes_filled`), never for a thin shell.
 pub fn fit(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) -> Result<FitOutput, FitError> {
     match fit_holes(input, config, progress) {
         Err(FitError::Mesh { fault: MeshFault::NoSiteInside, .. }) if config.sampling.solid == SolidRule::Auto => {
