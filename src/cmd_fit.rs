@@ -127,6 +127,12 @@ pub struct Args {
     /// default 256); gaps narrower than about 2.7 cells are closed.
     #[arg(long)]
     pub flood_cells: Option<usize>,
+    /// Keep an open mesh's planar holes open. By default, before the winding-number solid
+    /// is built, each hole whose rim lies in a plane (within 1% of its size) is closed flat
+    /// where that closes a piece with real volume (a cube without its bottom gets its
+    /// bottom); other holes are closed by the |winding number| = 0.5 surface.
+    #[arg(long)]
+    pub no_fill_holes: bool,
     /// Ask for an accuracy instead of a K: the certified Hausdorff distance to the input as
     /// a share of its bounding-box diagonal (`0.5%` or `0.005`). The fit starts at --sites
     /// and doubles K, refining where the error was, until met or --max-sites.
@@ -246,6 +252,7 @@ impl Args {
                 solid: self.solid,
                 shell_thickness: self.shell_thickness,
                 flood_cells: self.flood_cells,
+                no_fill_holes: self.no_fill_holes,
                 no_relabel: self.no_relabel,
                 carve: self.carve,
                 no_carve: self.no_carve,

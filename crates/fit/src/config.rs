@@ -56,6 +56,11 @@ pub struct Sampling {
     /// whose crust holds, see `target::thinnest_band`).
     #[serde(default)]
     pub shell_thickness: Option<f64>,
+    /// Close the input's planar holes flat before the winding-number solid is built
+    /// (`mesh_io::fill_planar_holes`; not for a thin shell). Absent in checkpoints written
+    /// before it existed: off, as they were sampled.
+    #[serde(default)]
+    pub fill_holes: bool,
     /// Cells of the flood fill's grid along the longest side of the mesh's box
     /// ([`SolidRule::Flood`]; gaps narrower than about 2.7 cells are closed).
     #[serde(default = "default_flood_cells")]
@@ -234,6 +239,7 @@ impl FitConfig {
                 solid: SolidRule::Auto,
                 shell_thickness: None,
                 flood_cells: DEFAULT_FLOOD_CELLS,
+                fill_holes: true,
             },
             eval: EvalSampling { samples: DEFAULT_EVAL_SAMPLES, sigmas: vec![0.01] },
             checkpointing: None,

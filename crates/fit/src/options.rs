@@ -54,6 +54,9 @@ pub struct FitOptions {
     /// Cells of the flood fill's grid along the longest side (default
     /// [`crate::config::DEFAULT_FLOOD_CELLS`]).
     pub flood_cells: Option<usize>,
+    /// Keep an open mesh's planar holes open (default: closed flat before the
+    /// winding-number solid is built, `mesh_io::fill_planar_holes`).
+    pub no_fill_holes: bool,
     /// Keep the training labels.
     pub no_relabel: bool,
     /// Carving tolerance as a fraction of the diagonal (default 0.3%).
@@ -100,6 +103,7 @@ impl FitOptions {
             }
             c.sampling.flood_cells = n;
         }
+        c.sampling.fill_holes = !self.no_fill_holes;
         c.train_shell = self.steps.is_some();
         // The paper preset is the paper's method: no polish, no relabelling, no insertion.
         c.relabel = !self.no_relabel && !paper;

@@ -192,8 +192,9 @@ fn a_shell_with_fewer_sites_than_a_rim_quadruplet_still_fits() {
 }
 
 /// An open pipe is an open mesh around a volume for the automatic rule (its winding number
-/// is 0.7–1 inside), so it keeps the winding solid, whose caps over the pipe's ends lie far
-/// from it: the summary says so and names `--solid shell`, which fits the pipe's wall.
+/// is 0.7–1 inside), so it keeps the winding solid: its planar ends are closed flat (a can
+/// with lids), or, with the fills off, by caps; either way the crust over the ends lies far
+/// from the pipe: the summary says so and names `--solid shell`, which fits the pipe's wall.
 #[test]
 fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
     let (nu, nv) = (48u32, 12u32);
@@ -213,8 +214,18 @@ fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
         }
     }
     let pipe = TriMesh { positions, triangles };
-    let out = fit::fit(&pipe, &small("pipe"), &mut NoProgress).unwrap();
+    let lids = fit::fit(&pipe, &small("pipe"), &mut NoProgress).unwrap();
+    assert_eq!(lids.report.solid.rule, SolidRule::Winding);
+    let filled = lids.report.solid.holes_filled.as_ref().unwrap();
+    assert_eq!((filled.loops_found, filled.loops_filled), (2, 2), "{filled:?}");
+    assert_eq!(lids.report.solid.cap_samples, 0);
+    let summary = lids.report.details();
+    assert!(summary.contains("--solid shell fits a thin shell"), "{summary}");
+    let mut open = small("pipe");
+    open.sampling.fill_holes = false;
+    let out = fit::fit(&pipe, &open, &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding);
+    assert!(out.report.solid.holes_filled.is_none());
     assert!(out.report.solid.cap_samples > 0);
     let summary = out.report.details();
     assert!(summary.contains("--solid shell fits a thin shell"), "{summary}");
@@ -229,8 +240,10 @@ fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
         fit::report::MetricsReport::Done(m) => m.hausdorff.hi / m.reference_diagonal,
         other => panic!("no metrics: {other:?}"),
     };
-    let (volume, wall) = (hausdorff(&out.report), hausdorff(&shell.report));
-    assert!(volume > 0.2 && wall < 0.5 * volume, "Hausdorff as a volume {volume}, as a shell {wall}");
+    for volume in [&lids, &out] {
+        let (volume, wall) = (hausdorff(&volume.report), hausdorff(&shell.report));
+        assert!(volume > 0.2 && wall < 0.5 * volume, "Hausdorff as a volume {volume}, as a shell {wall}");
+    }
     assert!(!shell.report.details().contains("--solid shell fits"));
 }
 

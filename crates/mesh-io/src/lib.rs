@@ -5,11 +5,13 @@
 //! [`write_mesh`] / [`write_gltf`] (atomic), [`TopologyReport::of`] and
 //! [`UnitCubeTransform`]. Checks before long work: [`OutputFormat::from_path`],
 //! [`check_output_location`], [`check_f32_resolution`]. Crack repair:
-//! [`weld::weld_tolerance`], [`weld::count_near_pairs`]. See the crate's README.md.
+//! [`weld::weld_tolerance`], [`weld::count_near_pairs`]. Open meshes: [`orient_consistently`],
+//! [`fill_planar_holes`]. See the crate's README.md.
 
 pub mod atomic;
 mod dsu;
 pub mod error;
+pub mod holes;
 pub mod limits;
 pub mod normalize;
 pub mod orient;
@@ -22,6 +24,7 @@ pub mod write;
 
 pub use atomic::atomic_write;
 pub use error::{ErrorKind, Location, MeshError};
+pub use holes::{fill_planar_holes, FillOptions, HoleFilling};
 pub use limits::{check_f32_resolution, check_representable};
 pub use normalize::UnitCubeTransform;
 pub use orient::{orient_consistently, Reorientation};

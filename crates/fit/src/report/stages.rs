@@ -51,6 +51,13 @@ pub struct SolidReport {
     /// F-score's τ of the sheet, and if not, about how many sites would put them there.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sheet_band: Option<SheetBand>,
+    /// The open input's holes closed flat before the solid was built
+    /// ([`mesh_io::fill_planar_holes`]; areas in input units squared): winding solid of an
+    /// open input only, absent otherwise. The filled mesh is the solid's surface: the
+    /// winding numbers, the surface samples and the caps (over the holes left open) are
+    /// those of the input with its fills; the metrics stay against the input as given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holes_filled: Option<mesh_io::HoleFilling>,
 }
 
 /// A sheet's band against the F-score's τ (report field `solid.sheet_band`): the band's
@@ -164,6 +171,9 @@ pub struct CarveReport {
     /// Of those, the mirror images of inserted sites across input faces near them
     /// (`carve::mirror_closure`), per round.
     pub inserted_as_mirrors_per_round: Vec<usize>,
+    /// Of those, the sites at crust vertices far from the input (`carve::peel_sites`), per
+    /// round.
+    pub inserted_as_peels_per_round: Vec<usize>,
     /// Why carving was run again without the mirrors, if it was: the crust with them could
     /// not be written in the output's precision (the main job then carves again from the
     /// same sites without them).

@@ -45,7 +45,13 @@ impl FitReport {
         let t = &self.settings.train;
         let c = &self.crust;
         let q = &self.quality;
-        let interior = format!("{}{}{}", self.reoriented_sentence(), self.interior_sentence(), self.caps_sentence());
+        let interior = format!(
+            "{}{}{}{}",
+            self.reoriented_sentence(),
+            self.holes_sentence(),
+            self.interior_sentence(),
+            self.caps_sentence()
+        );
         let polished = self.polish_sentence();
         let carved = format!("{}{}", self.carving_sentence(), self.guard_sentence());
         let pruned = self.pruning_sentence();
@@ -132,12 +138,19 @@ impl FitReport {
                 100.0 * (f.interior_share + f.crevice_share)
             );
         }
+        let flat = match &s.holes_filled {
+            Some(h) if h.loops_filled > 0 => {
+                format!(", {} planar hole{} closed flat", h.loops_filled, if h.loops_filled == 1 { "" } else { "s" })
+            }
+            _ => String::new(),
+        };
         match s.half_thickness_of_diagonal {
             Some(f) => format!("Solid: a thin shell around the surface, ±{:.3}% of the diagonal ({by})", 100.0 * f),
             None if s.cap_samples > 0 => {
-                format!("Solid: the winding-number volume |w| ≥ 0.5, holes capped ({by})")
+                let other = if flat.is_empty() { "" } else { "other " };
+                format!("Solid: the winding-number volume |w| ≥ 0.5{flat}, {other}holes capped ({by})")
             }
-            None => format!("Solid: the winding-number volume |w| ≥ 0.5 ({by})"),
+            None => format!("Solid: the winding-number volume |w| ≥ 0.5{flat} ({by})"),
         }
     }
 
@@ -217,9 +230,10 @@ impl FitReport {
                 let missed = |i: usize| pct(r.input_farthest_per_round.get(i).copied().unwrap_or(0.0));
                 let at_input: usize = r.inserted_at_input_per_round.iter().sum();
                 let mirrors: usize = r.inserted_as_mirrors_per_round.iter().sum();
+                let peels: usize = r.inserted_as_peels_per_round.iter().sum();
                 format!(
                     " Then {inserted} sites ({at_input} at input points far from the crust, {mirrors} mirror images \
-                     across faces near them) were inserted in {} \
+                     across faces near them, {peels} at crust vertices far from the input) were inserted in {} \
                      round(s) where the crust and the input lay more than {:.2}% of the diagonal apart (farthest \
                      crust vertex {:.3}% → {:.3}%; input point farthest from the crust {:.3}% → {:.3}%){}.",
                     r.inserted_per_round.len(),
@@ -371,6 +385,34 @@ impl FitReport {
         }
     }
 
+    /// The holes closed flat before the solid was built, and those left open, when the
+    /// input had any.
+    fn holes_sentence(&self) -> String {
+        let Some(h) = &self.solid.holes_filled else { return String::new() };
+        if h.loops_found == 0 {
+            return String::new();
+        }
+        let mut open = Vec::new();
+        for (n, why) in [
+            (h.open_not_planar, "rim not planar"),
+            (h.open_not_simple, "rim crossing itself in its plane"),
+            (h.open_shallow, "the fill would enclose no real volume, as a sheet's outline"),
+            (h.open_degenerate, "no area"),
+            (h.open_not_on_boundary, "the lid would lie inside or outside the solid, not on its boundary"),
+            (h.open_in_tangled_piece, "on a piece whose other open edges form no loop"),
+        ] {
+            if n > 0 {
+                open.push(format!("{n} {why}"));
+            }
+        }
+        let open = if open.is_empty() { String::new() } else { format!("; left open: {}", open.join(", ")) };
+        format!(
+            " Of the input's {} boundary loop(s), {} had a planar rim and were closed flat before the solid was built \
+             ({} triangles on the rims' own vertices, area {:.6e} in input units²), as the input's own faces{open}.",
+            h.loops_found, h.loops_filled, h.triangles_added, h.filled_area
+        )
+    }
+
     /// The interior surface left out of the samples, when any was.
     fn interior_sentence(&self) -> String {
         match (self.solid.interior_surface_share, self.solid.interior_surface_samples_dropped) {
@@ -387,33 +429,40 @@ impl FitReport {
     /// The caps across an open mesh's holes, with the hint to try a thin shell where they lie
     /// far from the input (winding solid of an open mesh only).
     fn caps_sentence(&self) -> String {
-        if self.solid.cap_samples > 0 {
-            // Caps that leave the crust far from the input: the mesh may be a surface (a pipe,
-            // crossing panels) rather than a volume's skin with holes. Say what to try.
-            let far = match &self.metrics {
-                MetricsReport::Done(m) if m.reference_diagonal > 0.0 => {
-                    let share = m.hausdorff.directed_witness[1] / m.reference_diagonal;
-                    if share >= SHELL_HINT_ABOVE {
-                        format!(
-                            " Part of the crust (those caps) lies {:.1}% of the diagonal from the input: if the mesh is \
-                             one surface (a pipe, a mask, crossing panels) rather than the skin of a volume with holes, \
-                             --solid shell fits a thin shell around it instead.",
-                            100.0 * share
-                        )
-                    } else {
-                        String::new()
-                    }
+        let filled = self.solid.holes_filled.as_ref().is_some_and(|h| h.loops_filled > 0);
+        // Caps or lids that leave the crust far from the input: the mesh may be a surface (a
+        // pipe, crossing panels) rather than a volume's skin with holes. Say what to try.
+        let far = match &self.metrics {
+            MetricsReport::Done(m) if m.reference_diagonal > 0.0 && (self.solid.cap_samples > 0 || filled) => {
+                let share = m.hausdorff.directed_witness[1] / m.reference_diagonal;
+                let those = match (self.solid.cap_samples > 0, filled) {
+                    (true, true) => "those caps and flat fills",
+                    (true, false) => "those caps",
+                    _ => "those flat fills",
+                };
+                if share >= SHELL_HINT_ABOVE {
+                    format!(
+                        " Part of the crust ({those}) lies {:.1}% of the diagonal from the input: if the mesh is \
+                         one surface (a pipe, a mask, crossing panels) rather than the skin of a volume with holes, \
+                         --solid shell fits a thin shell around it instead.",
+                        100.0 * share
+                    )
+                } else {
+                    String::new()
                 }
-                _ => String::new(),
-            };
+            }
+            _ => String::new(),
+        };
+        if self.solid.cap_samples > 0 {
+            let other = if filled { "other " } else { "" };
             format!(
-                " The solid closes the input's holes by the |winding number| = 0.5 surface; {} points of \
+                " The solid closes the input's {other}holes by the |winding number| = 0.5 surface; {} points of \
                  it beyond the input's edges were added to the surface samples (caps and their rims), so sites \
                  stand there too.{far}",
                 self.solid.cap_samples
             )
         } else {
-            String::new()
+            far
         }
     }
 

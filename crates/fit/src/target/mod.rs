@@ -104,7 +104,7 @@ pub(crate) fn choose<'a>(
     let w = oracle
         .winding_numbers(probe, occupancy::WindingMode::Fast)
         .map_err(|source| FitError::Occupancy { during: "winding numbers", source })?;
-    let ambiguous = w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64;
+    let ambiguous = ambiguous_share(&w);
     let winding_probe: Vec<bool> = w.iter().map(|&w| oracle.config().is_inside_winding(w)).collect();
     let h_sheet = shell_half_thickness(s.shell_thickness, sampler.total_area(), config.train.num_sites, diagonal);
     // The flood solid is looked at for every open mesh under auto (a closed mesh's
@@ -142,6 +142,7 @@ pub(crate) fn choose<'a>(
             interior_surface_samples_dropped: 0,
             cap_samples: 0,
             thickness_search: None,
+            holes_filled: None,
             flood: Some(flood_report(f)),
             sheet_band: (f.sheet_share() > SHEET_BAND_MIN_SHARE)
                 .then(|| SheetBand::of(f.sheet_half_thickness() / diagonal, config.train.num_sites)),
@@ -195,6 +196,7 @@ pub(crate) fn choose<'a>(
             interior_surface_samples_dropped: dropped,
             cap_samples: caps,
             thickness_search: None,
+            holes_filled: None,
             flood: flood.as_ref().map(flood_report),
             sheet_band: None,
         };
@@ -247,10 +249,16 @@ pub(crate) fn choose<'a>(
         interior_surface_samples_dropped: 0,
         cap_samples: 0,
         thickness_search,
+        holes_filled: None,
         flood: flood.as_ref().map(flood_report),
         sheet_band: Some(SheetBand::of(h / diagonal, config.train.num_sites)),
     };
     Ok((Target::Shell(solid, sites, labels), report))
+}
+
+/// Share of winding numbers with 0.25 < |w| < 0.75 ([`SHELL_ABOVE`]).
+pub(crate) fn ambiguous_share(w: &[f64]) -> f64 {
+    w.iter().filter(|w| (0.25..0.75).contains(&w.abs())).count() as f64 / w.len().max(1) as f64
 }
 
 #[cfg(test)]

@@ -65,6 +65,7 @@ _FIT_OPTIONS = {
     "eval_samples",
     "solid",
     "shell_thickness",
+    "no_fill_holes",
     "skip_metrics",
     "polish_steps",
     "polish_lr",
@@ -330,7 +331,7 @@ def fit(
             ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell" | "flood"), shell_thickness, flood_cells,
-            skip_metrics,
+            no_fill_holes (keep planar holes open), skip_metrics,
             polish_steps (0: no polish), polish_lr, polish_align (None: on a closed mesh both
             polishes, the aligned crust kept where it is at least as good on all four metrics,
             Hausdorff distances both within the F-score's tau or with overlapping certified

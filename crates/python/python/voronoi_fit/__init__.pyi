@@ -61,6 +61,7 @@ def fit(
     eval_samples: Optional[int] = None,
     solid: Optional[str] = None,
     shell_thickness: Optional[float] = None,
+    no_fill_holes: Optional[bool] = None,
     skip_metrics: Optional[bool] = None,
     polish_steps: Optional[int] = None,
     polish_lr: Optional[float] = None,
