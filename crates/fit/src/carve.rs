@@ -184,9 +184,12 @@ pub fn carve(
             mirror_closure(oracle, solid, &samples, index, &mut new, tolerance, round_budget)?;
         }
         let mirrors = new.len() - pairs;
-        // Sites at the crust's vertices far from the input themselves ([`peel_sites`]).
+        // Sites at the crust's vertices far from the input themselves ([`peel_sites`]),
+        // on open inputs only.
         let before_peels = new.len();
-        new.extend(peel_sites(&stray, mesh, &open_edges, tolerance, round_budget.saturating_sub(new.len())));
+        if !open_edges.is_empty() {
+            new.extend(peel_sites(&stray, mesh, &open_edges, tolerance, round_budget.saturating_sub(new.len())));
+        }
         // Each site is labelled by the solid, whatever it gives: at a thin tip both sites of
         // a pair may land outside (or inside), and two outside sites there are exactly what
         // cuts a spike back. (Keeping only pairs that straddle the surface, as the initial
@@ -502,6 +505,10 @@ fn pairs_at(
 /// 11.5% to 1.5%.
 /// Vertices whose foot is on the rim of a hole in the input are skipped, as in
 /// [`pairs_at`]: they lie on the solid's cap across the hole, where they belong.
+/// Called only for inputs with open edges: on a closed mesh every part has outside sites
+/// beyond it and the pairs reach the spikes, and peels there only changed which rounds
+/// followed (menger at K = 8,192: Hausdorff 1.81% → 2.14% of the diagonal, genus kept
+/// 1,097 → 1,060 of 1,409).
 fn peel_sites(
     stray: &[Stray],
     mesh: &TriMesh,
@@ -517,7 +524,9 @@ fn peel_sites(
         if on_open_edge(mesh, st.triangle as usize, st.foot, open_edges, 1e-9) {
             continue;
         }
-        let v = [0, 1, 2].map(|i| st.foot[i] + st.distance * st.direction[i]);
+        // Inside the domain box like every inserted site: a crust vertex can lie on the box's
+        // face (at menger's 8k a peel at y = 1.0 stopped the round's extraction).
+        let v = [0, 1, 2].map(|i| (st.foot[i] + st.distance * st.direction[i]).clamp(1e-6, 1.0 - 1e-6));
         let spacing = 0.5 * st.distance;
         if out.iter().all(|p| distance_squared(*p, v) >= spacing * spacing) {
             out.push(v);
@@ -670,6 +679,29 @@ fn on_open_edge(mesh: &TriMesh, t: usize, c: [f64; 3], open: &[(u32, u32)], eps:
 mod tests {
     use super::*;
     use mesh_io::shapes::cuboid;
+
+    /// A peel site stays strictly inside the domain box even where the crust vertex lies on
+    /// the box's face, and one nearer an earlier peel than half its distance is dropped.
+    #[test]
+    fn peel_sites_stay_inside_the_box() {
+        let plate = cuboid([0.3, 0.3, 0.5], [0.7, 0.7, 0.6]);
+        let stray = |foot: [f64; 3], distance: f64| Stray {
+            distance,
+            foot,
+            direction: [0.0, 1.0, 0.0],
+            triangle: 0,
+            at_input: false,
+        };
+        // Crust vertices at y = 1.0 (on the box's face) and 0.01 beside the first.
+        let strays = [stray([0.5, 0.7, 0.55], 0.3), stray([0.51, 0.7, 0.55], 0.3), stray([0.5, 0.7, 0.55], 0.1)];
+        let out = peel_sites(&strays, &plate, &[], 0.01, 10);
+        assert_eq!(out.len(), 2, "{out:?}");
+        assert!(out.iter().flatten().all(|&c| c > 0.0 && c < 1.0), "{out:?}");
+        assert_eq!(out[0], [0.5, 1.0 - 1e-6, 0.55]);
+        assert!((out[1][1] - 0.8).abs() < 1e-12, "{out:?}");
+        // Nearer the input than PEEL_REACH tolerances: none.
+        assert!(peel_sites(&strays, &plate, &[], 0.1, 10).is_empty());
+    }
 
     /// The mirror closure of `pair` (outside site first) at the centre of a square plate
     /// `w` thick (top face at z = 0.5 + w), tolerance `t`.

@@ -88,9 +88,10 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert_eq!(solid.inside(&sites[n0..]), new_labels);
     // The first round's pairs (its first sites, before any mirror images and peel sites at
     // the crust's vertices) straddle the surface.
-    let first_pairs = report.inserted_per_round[0]
-        - report.inserted_as_mirrors_per_round[0]
-        - report.inserted_as_peels_per_round[0];
+    // The sphere is closed: no peel sites (only open inputs get them).
+    assert!(report.inserted_as_peels_per_round.iter().all(|&p| p == 0), "{report:?}");
+    let first_pairs =
+        report.inserted_per_round[0] - report.inserted_as_mirrors_per_round[0] - report.inserted_as_peels_per_round[0];
     assert!(first_pairs > 0 && first_pairs.is_multiple_of(2), "{report:?}");
     assert!(new_labels[..first_pairs].chunks(2).all(|p| p[0] != p[1]), "{new_labels:?}");
     assert!(report.farthest_after <= report.farthest_before);
