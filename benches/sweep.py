@@ -11,8 +11,10 @@ the fit; exit 1, a crash, a timeout or a missing output is.
 Only the standard library: it calls the prebuilt binary (`target/ci/voronoi-fit`, or
 `--bin`) at the defaults except `--sites` and `--seed`, and reads each
 report's `solid.rule` and certified Hausdorff distance. Writes `benches/results/sweep.csv`
-(one row per fit, rewritten after every row so a killed run keeps its rows; rows of earlier
-runs with other keys are kept), `sweep.md` (the tally) and their provenance sidecars.
+(one row per fit with the commit it ran at, rewritten after every fit so a killed run keeps
+its rows; rows of earlier runs with other keys are kept, `--skip-done` skips the keys
+already there), `sweep.md` (the tally) and their provenance sidecars. Seeds are the
+outermost loop, so a run stopped early has every mesh at every K for the seeds it finished.
 """
 import argparse
 import csv
@@ -26,7 +28,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benches" / "results"
-FIELDS = ["mesh", "sites", "seed", "exit", "status", "seconds", "solid", "hausdorff_pct", "error"]
+FIELDS = ["mesh", "sites", "seed", "commit", "exit", "status", "seconds", "solid", "hausdorff_pct", "error"]
 
 
 def meshes():
@@ -71,6 +73,33 @@ def run_one(binary, path, k, seed, timeout):
         return row
 
 
+def write(out, csv_path, done, command, commit):
+    """The CSV, the tally (sweep.md) and their provenance sidecars, from every row so far."""
+    with open(csv_path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=FIELDS, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(done.values())
+    rows = list(done.values())
+    tally = {}
+    for r in rows:
+        tally[r["status"]] = tally.get(r["status"], 0) + 1
+    bad = [r for r in rows if r["status"] not in ("ok", "input fault")]
+    lines = ["# The main job over shared meshes, assets and real-world meshes × K × seeds", "",
+             f"`{command.strip()}`. One row per fit in [sweep.csv](sweep.csv).", "",
+             "| status | fits |", "|---|---:|"]
+    lines += [f"| {s} | {n} |" for s, n in sorted(tally.items())]
+    lines += ["", f"Meshes: {len({r['mesh'] for r in rows})}; K: "
+              f"{', '.join(str(k) for k in sorted({int(r['sites']) for r in rows}))}; "
+              f"fits: {len(rows)}; failed after their work or timed out: {len(bad)}.", ""]
+    for r in bad:
+        lines.append(f"- {r['mesh']} K={r['sites']} seed={r['seed']}: {r['status']} {r.get('error', '')}")
+    (out / "sweep.md").write_text("\n".join(lines) + "\n")
+    prov = {"command": command.strip(), "commit": commit, "date": datetime.now(timezone.utc).strftime("%Y-%m-%d"),
+            "notes": "prebuilt ci-profile binary (release + debug assertions) on a shared 2-core machine"}
+    for p in (csv_path, out / "sweep.md"):
+        Path(str(p) + ".provenance.json").write_text(json.dumps(prov, indent=2) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default=str(ROOT / "target" / "ci" / "voronoi-fit"))
@@ -80,6 +109,8 @@ def main():
     ap.add_argument("--meshes", help="comma-separated names (default: all)")
     ap.add_argument("--timeout", type=float, default=900)
     ap.add_argument("--out", default=str(RESULTS))
+    ap.add_argument("--skip-done", action="store_true",
+                    help="skip the fits already in the CSV (a run split over several sessions)")
     args = ap.parse_args()
     all_meshes = real_world() if args.real_world else meshes()
     names = args.meshes.split(",") if args.meshes else list(all_meshes)
@@ -94,39 +125,27 @@ def main():
         with open(csv_path) as f:
             for r in csv.DictReader(f):
                 done[(r["mesh"], int(r["sites"]), int(r["seed"]))] = r
-    for k in [int(x) for x in args.sites.split(",")]:
-        for name in names:
-            for seed in [int(x) for x in args.seeds.split(",")]:
-                row = dict(mesh=name, sites=k, seed=seed)
+    command = "python3 benches/sweep.py " + " ".join(sys.argv[1:])
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                            cwd=ROOT).stdout.strip()
+    # Seeds outermost, so that a run stopped early has every mesh at every K for the seeds
+    # it finished; the CSV, tally and provenance are rewritten after every fit.
+    for seed in [int(x) for x in args.seeds.split(",")]:
+        for k in [int(x) for x in args.sites.split(",")]:
+            for name in names:
+                if args.skip_done and (name, k, seed) in done:
+                    continue
+                row = dict(mesh=name, sites=k, seed=seed, commit=commit)
                 row.update(run_one(args.bin, all_meshes[name], k, seed, args.timeout))
                 print(row, flush=True)
                 done[(name, k, seed)] = row
-                with open(csv_path, "w", newline="") as f:
-                    w = csv.DictWriter(f, fieldnames=FIELDS, extrasaction="ignore")
-                    w.writeheader()
-                    w.writerows(done.values())
+                write(out, csv_path, done, command, commit)
+    write(out, csv_path, done, command, commit)
     rows = list(done.values())
     tally = {}
     for r in rows:
         tally[r["status"]] = tally.get(r["status"], 0) + 1
     bad = [r for r in rows if r["status"] not in ("ok", "input fault")]
-    command = "python3 benches/sweep.py " + " ".join(sys.argv[1:])
-    lines = ["# The main job over shared meshes, assets and real-world meshes × K × seeds", "",
-             f"`{command.strip()}`. One row per fit in [sweep.csv](sweep.csv).", "",
-             "| status | fits |", "|---|---:|"]
-    lines += [f"| {s} | {n} |" for s, n in sorted(tally.items())]
-    lines += ["", f"Meshes: {len({r['mesh'] for r in rows})}; K: "
-              f"{', '.join(str(k) for k in sorted({int(r['sites']) for r in rows}))}; "
-              f"fits: {len(rows)}; failed after their work or timed out: {len(bad)}.", ""]
-    for r in bad:
-        lines.append(f"- {r['mesh']} K={r['sites']} seed={r['seed']}: {r['status']} {r.get('error', '')}")
-    (out / "sweep.md").write_text("\n".join(lines) + "\n")
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                            cwd=ROOT).stdout.strip()
-    prov = {"command": command.strip(), "commit": commit, "date": datetime.now(timezone.utc).strftime("%Y-%m-%d"),
-            "notes": "prebuilt ci-profile binary (release + debug assertions) on a shared 2-core machine"}
-    for p in (csv_path, out / "sweep.md"):
-        Path(str(p) + ".provenance.json").write_text(json.dumps(prov, indent=2) + "\n")
     print(f"{len(rows)} fits: {tally}")
     return 1 if bad else 0
 

@@ -41,6 +41,8 @@ pub struct CarveOptions {
     pub max_new: usize,
     /// Whether the inserted sites get their mirror images ([`mirror_closure`]).
     pub mirrors: bool,
+    /// Whether crust vertices far from the input get sites of their own ([`peel_sites`]).
+    pub peels: bool,
     /// Stop before the first round (nothing inserted; [`CarveReport::gated`]) when the
     /// uncarved crust's Chamfer distance is larger or its normal consistency lower than
     /// these: the fit's second, aligned polish is measured against the plain one's this way
@@ -51,8 +53,14 @@ pub struct CarveOptions {
 impl CarveOptions {
     /// The main job's: [`ROUNDS`] rounds and K/8 sites for `k` sites, with mirrors.
     pub fn for_sites(tolerance: f64, k: usize) -> Self {
-        CarveOptions { tolerance, rounds: ROUNDS, max_new: k / 8, mirrors: true, gate: None }
+        CarveOptions { tolerance, rounds: ROUNDS, max_new: k / 8, mirrors: true, peels: true, gate: None }
     }
+}
+
+/// Whether the main job's carving places [`peel_sites`]: for every solid but the winding
+/// solid (`winding`) of a mesh without open edges (see [`peel_sites`] for why).
+pub fn peels_for(winding: bool, mesh: &TriMesh) -> bool {
+    !winding || !mesh_io::topology::boundary_edges(mesh).is_empty()
 }
 
 /// Rounds of the main job's carving ([`CarveOptions::for_sites`]).
@@ -79,7 +87,7 @@ pub fn carve(
     solid: &dyn Solid,
     options: &CarveOptions,
 ) -> Result<CarveReport, FitError> {
-    let CarveOptions { tolerance, rounds, max_new, mirrors, gate } = *options;
+    let CarveOptions { tolerance, rounds, max_new, mirrors, peels, gate } = *options;
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
     let open_edges = mesh_io::topology::boundary_edges(mesh);
@@ -184,10 +192,9 @@ pub fn carve(
             mirror_closure(oracle, solid, &samples, index, &mut new, tolerance, round_budget)?;
         }
         let mirrors = new.len() - pairs;
-        // Sites at the crust's vertices far from the input themselves ([`peel_sites`]),
-        // on open inputs only.
+        // Sites at the crust's vertices far from the input themselves ([`peel_sites`]).
         let before_peels = new.len();
-        if !open_edges.is_empty() {
+        if peels {
             new.extend(peel_sites(&stray, mesh, &open_edges, tolerance, round_budget.saturating_sub(new.len())));
         }
         // Each site is labelled by the solid, whatever it gives: at a thin tip both sites of
@@ -505,10 +512,12 @@ fn pairs_at(
 /// 11.5% to 1.5%.
 /// Vertices whose foot is on the rim of a hole in the input are skipped, as in
 /// [`pairs_at`]: they lie on the solid's cap across the hole, where they belong.
-/// Called only for inputs with open edges: on a closed mesh every part has outside sites
-/// beyond it and the pairs reach the spikes, and peels there only changed which rounds
-/// followed (menger at K = 8,192: Hausdorff 1.81% → 2.14% of the diagonal, genus kept
-/// 1,097 → 1,060 of 1,409).
+/// Only when [`CarveOptions::peels`]: the main job leaves them out for the winding solid of
+/// a mesh without open edges, where every part has outside sites beyond it and the pairs
+/// reach the spikes, and peels only changed which rounds followed (menger at K = 8,192:
+/// Hausdorff 1.81% → 2.14% of the diagonal, genus kept 1,097 → 1,060 of 1,409). Soups
+/// whose faces are doubled have no open edges either, but take the flood solid and keep
+/// them (the ShapeNet airplane).
 fn peel_sites(
     stray: &[Stray],
     mesh: &TriMesh,
@@ -679,6 +688,17 @@ fn on_open_edge(mesh: &TriMesh, t: usize, c: [f64; 3], open: &[(u32, u32)], eps:
 mod tests {
     use super::*;
     use mesh_io::shapes::cuboid;
+
+    /// Peels for the winding solid only of an open mesh; for the other solids always.
+    #[test]
+    fn peels_for_open_meshes_and_other_solids() {
+        let closed = cuboid([0.3, 0.3, 0.3], [0.7, 0.7, 0.7]);
+        let mut open = closed.clone();
+        open.triangles.truncate(open.triangles.len() - 2);
+        assert!(!peels_for(true, &closed));
+        assert!(peels_for(true, &open));
+        assert!(peels_for(false, &closed) && peels_for(false, &open));
+    }
 
     /// A peel site stays strictly inside the domain box even where the crust vertex lies on
     /// the box's face, and one nearer an earlier peel than half its distance is dropped.

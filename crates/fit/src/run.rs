@@ -652,8 +652,11 @@ impl AfterTraining<'_> {
                 Some(c) => {
                     let k = self.trainer.config().num_sites;
                     let tolerance = c * self.diagonal;
+                    let winding = matches!(self.target, crate::target::Target::Winding(_));
+                    let peels = crate::carve::peels_for(winding, &self.p.unit);
                     let options = crate::carve::CarveOptions {
                         mirrors,
+                        peels,
                         gate,
                         ..crate::carve::CarveOptions::for_sites(tolerance, k)
                     };

@@ -51,7 +51,7 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert!(before > 0.02, "the gap makes a spike: {before}");
     let tolerance = 0.004;
     let n0 = sites.len();
-    let options = CarveOptions { tolerance, rounds: 4, max_new: 400, mirrors: true, gate: None };
+    let options = CarveOptions { tolerance, rounds: 4, max_new: 400, mirrors: true, peels: false, gate: None };
     let (start_sites, start_labels) = (sites.clone(), labels.clone());
     let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, &options).unwrap();
     // The gate: an uncarved crust short of the bar (here, of an unreachable normal
@@ -88,7 +88,7 @@ fn pairs_at_the_feet_cut_a_spike_back() {
     assert_eq!(solid.inside(&sites[n0..]), new_labels);
     // The first round's pairs (its first sites, before any mirror images and peel sites at
     // the crust's vertices) straddle the surface.
-    // The sphere is closed: no peel sites (only open inputs get them).
+    // Peel sites were not asked for.
     assert!(report.inserted_as_peels_per_round.iter().all(|&p| p == 0), "{report:?}");
     let first_pairs =
         report.inserted_per_round[0] - report.inserted_as_mirrors_per_round[0] - report.inserted_as_peels_per_round[0];
@@ -188,7 +188,7 @@ fn pairs_at_input_far_from_the_crust_bring_a_lost_part_back() {
     let tolerance = 0.004;
     // The budget covers two rounds over the box: its first round's pairs (turned to bisect
     // the box's edges, not left out there) and their mirrors take 600 sites.
-    let options = CarveOptions { tolerance, rounds: 4, max_new: 900, mirrors: true, gate: None };
+    let options = CarveOptions { tolerance, rounds: 4, max_new: 900, mirrors: true, peels: true, gate: None };
     let report = carve(&mut sites, &mut labels, &oracle, &unit, &solid, &options).unwrap();
     let input = &report.input_farthest_per_round;
     let kept = report.inserted_per_round.len();
