@@ -142,3 +142,33 @@ fn a_flood_grid_out_of_range_is_refused_before_any_work() {
     let o = fit::FitOptions { flood_cells: Some(64), ..Default::default() };
     assert_eq!(o.to_config("m").unwrap().sampling.flood_cells, 64);
 }
+
+/// A volume-filling soup like libigl's `cube_40k.obj`: a 6 × 6 × 6 grid of cubes, each with
+/// its own 12 triangles (every inner face doubled), the grid's side at x = 1 left open.
+/// Most of its surface lies inside the enclosed part, not on its boundary: auto takes the
+/// flood solid for it all the same (`config::FLOOD_ENCLOSED_SHARE`).
+#[test]
+fn a_volume_filling_soup_takes_the_flood_solid() {
+    let n = 6;
+    let mut soup = TriMesh { positions: vec![], triangles: vec![] };
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let lo = [i, j, k].map(|c| c as f64 / n as f64);
+                let mut cell = cuboid(lo, lo.map(|c| c + 1.0 / n as f64));
+                cell.triangles.retain(|t| !t.iter().all(|&v| cell.positions[v as usize][0] == 1.0));
+                append(&mut soup, &cell);
+            }
+        }
+    }
+    let mut c = common::small("grid of cubes", 512, 20, 50_000, 20_000);
+    c.sampling.solid = SolidRule::Auto;
+    let out = fit::fit(&soup, &c, &mut NoProgress).unwrap();
+    let s = &out.report.solid;
+    assert_eq!((s.rule, s.chosen_by), (SolidRule::Flood, "auto"), "{}", out.report.details());
+    let f = s.flood.as_ref().unwrap();
+    // The boundary alone is short of the rule's quarter; with the inner faces it is half.
+    assert!(f.boundary_share < fit::config::FLOOD_BOUNDARY_SHARE, "{f:?}");
+    assert!(f.boundary_share + f.interior_share >= fit::config::FLOOD_ENCLOSED_SHARE, "{f:?}");
+    assert!(out.report.crust.is_closed && out.report.crust.is_manifold, "{:?}", out.report.crust);
+}

@@ -112,10 +112,11 @@ pub struct FloodReport {
     /// second test, `config::FLOOD_DISAGREEMENT`).
     pub disagreement: f64,
     /// Surface with the flood's enclosed side on one side and outside on the other: the
-    /// solid's boundary, where the input is (the auto rule's first test,
-    /// `config::FLOOD_BOUNDARY_SHARE`).
+    /// solid's boundary, where the input is (with `interior_share`, the auto rule's first
+    /// test, `config::FLOOD_BOUNDARY_SHARE`).
     pub boundary_share: f64,
-    /// Surface enclosed on both sides (doubled, buried or touching faces): left out.
+    /// Surface enclosed on both sides (doubled, buried or touching faces): left out (counted
+    /// with `boundary_share` in the auto rule's first test, `config::FLOOD_ENCLOSED_SHARE`).
     pub interior_share: f64,
     /// Surface with the outside on both sides (single-sided panels, sheets, the walls of
     /// boxes open wider than the grid closes): thickened into bands.

@@ -11,7 +11,7 @@ use soft_voronoi::{FloodSolid, MeshSolid, Solid, SurfaceSide, TrainingData};
 /// Uniform points of the pool on which the flood and winding solids' volumes are compared.
 pub(super) const PROBE: usize = 20_000;
 
-use crate::config::{FLOOD_BOUNDARY_SHARE, FLOOD_DISAGREEMENT};
+use crate::config::{FLOOD_BOUNDARY_SHARE, FLOOD_DISAGREEMENT, FLOOD_ENCLOSED_SHARE};
 use crate::error::FitError;
 use crate::report::FloodReport;
 
@@ -78,10 +78,13 @@ impl<'a> FloodLook<'a> {
         self.solid.sheet_half_thickness
     }
 
-    /// The auto rule's test ([`FLOOD_BOUNDARY_SHARE`]).
+    /// The auto rule's test ([`FLOOD_BOUNDARY_SHARE`], [`FLOOD_ENCLOSED_SHARE`]).
     pub(super) fn wanted(&self) -> bool {
-        let boundary = self.sides.iter().filter(|&&s| s == SurfaceSide::Boundary).count();
-        boundary as f64 >= FLOOD_BOUNDARY_SHARE * self.sides.len() as f64 && self.disagreement >= FLOOD_DISAGREEMENT
+        let n = self.sides.len() as f64;
+        let boundary = self.sides.iter().filter(|&&s| s == SurfaceSide::Boundary).count() as f64;
+        let interior = self.sides.iter().filter(|&&s| s == SurfaceSide::Interior).count() as f64;
+        let enclosing = boundary >= FLOOD_BOUNDARY_SHARE * n || boundary + interior >= FLOOD_ENCLOSED_SHARE * n;
+        enclosing && self.disagreement >= FLOOD_DISAGREEMENT
     }
 
     /// The report's part, with lengths in input units (`scale` per unit-cube length).
