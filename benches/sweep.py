@@ -39,7 +39,8 @@ def meshes():
         if p.suffix.lower() in (".obj", ".stl", ".ply", ".off", ".glb", ".gltf"):
             found[p.stem.split("__")[-1]] = p
     for p in sorted((ROOT / "assets").glob("*.obj")):
-        found[p.stem] = p
+        # assets/bunny.obj beside the shared bunny scan: both are fitted, under two names.
+        found[p.stem if p.stem not in found else f"assets_{p.stem}"] = p
     return found
 
 
