@@ -176,7 +176,10 @@ fn bad_input_exits_2_names_the_problem_and_writes_nothing() {
             vec![root().join("assets/bunny.obj").into(), "--target-hausdorff".into(), "200%".into()],
             "between 0 and 100%",
         ),
-        (vec![root().join("assets/bunny.obj").into(), "--solid".into(), "hollow".into()], "auto, winding, shell or flood"),
+        (
+            vec![root().join("assets/bunny.obj").into(), "--solid".into(), "hollow".into()],
+            "auto, winding, shell or flood",
+        ),
         (vec!["/no/such/mesh.obj".into()], "/no/such/mesh.obj"),
         (vec![root().join("assets/bunny.obj").into(), "--sites".into(), "1".into()], "sites"),
         (vec![root().join("assets/bunny.obj").into(), "--lr".into(), "nan".into()], "learning rate"),
