@@ -17,6 +17,7 @@ pub mod config;
 pub mod data;
 pub mod dense;
 pub mod error;
+pub mod grid;
 pub mod init;
 pub mod kernel;
 pub mod knn;

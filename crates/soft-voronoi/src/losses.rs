@@ -366,6 +366,98 @@ pub fn surface(
     surface_hinted(index, sites, points, normals, &mut hints, normal_weight, 0.0, weight, grad)
 }
 
+/// One surface sample's part of [`surface_hinted`]: x with unit normal `nx`, its nearest
+/// inside site `ia` and nearest outside site `ib`; adds its loss into `loss` and the
+/// trainable sites' gradients into `contributions`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn surface_one(
+    sites: &[[f64; 3]],
+    x: [f64; 3],
+    nx: [f64; 3],
+    ia: u32,
+    ib: u32,
+    normal_weight: f64,
+    min_cos: f64,
+    trainable: u32,
+    loss: &mut f64,
+    contributions: &mut Vec<(u32, [f64; 3])>,
+) {
+    let (a, b) = (sites[ia as usize], sites[ib as usize]);
+    let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+    if len == 0.0 {
+        return;
+    }
+    let r = [0, 1, 2].map(|c| x[c] - 0.5 * (a[c] + b[c]));
+    let d = (r[0] * e[0] + r[1] * e[1] + r[2] * e[2]) / len;
+    *loss += d * d;
+    // ∂d/∂a = (−e/2 − r)/|e| + d·u/|e|, ∂d/∂b = (−e/2 + r)/|e| − d·u/|e|, u = e/|e|.
+    let f = 2.0 * d / len;
+    let mut ga = [0, 1, 2].map(|c| f * (-0.5 * e[c] - r[c] + d * e[c] / len));
+    let mut gb = [0, 1, 2].map(|c| f * (-0.5 * e[c] + r[c] - d * e[c] / len));
+    let un = (e[0] * nx[0] + e[1] * nx[1] + e[2] * nx[2]) / len;
+    if normal_weight > 0.0 && un.abs() >= min_cos {
+        // 1 − (u·n)²; ∂(u·n)/∂e = (n − (u·n) u)/|e|, ∂e/∂b = I = −∂e/∂a.
+        *loss += normal_weight * (1.0 - un * un);
+        let g = -2.0 * normal_weight * un / len;
+        for c in 0..3 {
+            let de = g * (nx[c] - un * e[c] / len);
+            gb[c] += de;
+            ga[c] -= de;
+        }
+    }
+    if ia < trainable {
+        contributions.push((ia, ga));
+    }
+    if ib < trainable {
+        contributions.push((ib, gb));
+    }
+}
+
+/// [`surface_hinted`] where the caller already knows, for most samples, the nearest inside
+/// and outside site: `pairs[i]` is that pair when `known[i]`, else the pair is searched in
+/// `index` (built from `labels` on the first such sample). Same result as [`surface_hinted`], bit for
+/// bit: the polish finds the pairs among the 11 nearest sites it looks up anyway.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn surface_paired(
+    index: &std::sync::OnceLock<LabelledIndex>,
+    labels: &[bool],
+    sites: &[[f64; 3]],
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    pairs: &[([u32; 2], bool)],
+    normal_weight: f64,
+    min_cos: f64,
+    weight: f64,
+    grad: &mut [[f64; 3]],
+) -> f64 {
+    let m = points.len().max(1) as f64;
+    let trainable = grad.len() as u32;
+    let parts: Vec<ChunkPart<3>> = points
+        .par_chunks(CHUNK)
+        .zip(normals.par_chunks(CHUNK))
+        .zip(pairs.par_chunks(CHUNK))
+        .map(|((xs, ns), ps)| {
+            let mut contributions = Vec::with_capacity(2 * xs.len());
+            let mut loss = 0.0;
+            for ((&x, &nx), &(pair, known)) in xs.iter().zip(ns).zip(ps) {
+                let (ia, ib) = if known {
+                    (pair[0], pair[1])
+                } else {
+                    match index.get_or_init(|| LabelledIndex::new(sites, labels)).nearest_pair(sites, x) {
+                        Some(p) => p,
+                        None => continue,
+                    }
+                };
+                surface_one(sites, x, nx, ia, ib, normal_weight, min_cos, trainable, &mut loss, &mut contributions);
+            }
+            (loss, contributions)
+        })
+        .collect();
+    reduce(parts, weight / m, grad) / m
+}
+
 /// [`surface`] warm-started: `hints` holds, per point, an inside and an outside site that
 /// were near it (or [`NO_HINT`]), and is set to the nearest pair; the result does not
 /// depend on it.
@@ -392,36 +484,7 @@ pub fn surface_hinted(
             let mut loss = 0.0;
             for ((&x, &nx), h) in xs.iter().zip(ns).zip(hs) {
                 let Some((ia, ib)) = index.nearest_pair_hinted(sites, x, h) else { continue };
-                let (a, b) = (sites[ia as usize], sites[ib as usize]);
-                let e = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-                let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-                if len == 0.0 {
-                    continue;
-                }
-                let r = [0, 1, 2].map(|c| x[c] - 0.5 * (a[c] + b[c]));
-                let d = (r[0] * e[0] + r[1] * e[1] + r[2] * e[2]) / len;
-                loss += d * d;
-                // ∂d/∂a = (−e/2 − r)/|e| + d·u/|e|, ∂d/∂b = (−e/2 + r)/|e| − d·u/|e|, u = e/|e|.
-                let f = 2.0 * d / len;
-                let mut ga = [0, 1, 2].map(|c| f * (-0.5 * e[c] - r[c] + d * e[c] / len));
-                let mut gb = [0, 1, 2].map(|c| f * (-0.5 * e[c] + r[c] - d * e[c] / len));
-                let un = (e[0] * nx[0] + e[1] * nx[1] + e[2] * nx[2]) / len;
-                if normal_weight > 0.0 && un.abs() >= min_cos {
-                    // 1 − (u·n)²; ∂(u·n)/∂e = (n − (u·n) u)/|e|, ∂e/∂b = I = −∂e/∂a.
-                    loss += normal_weight * (1.0 - un * un);
-                    let g = -2.0 * normal_weight * un / len;
-                    for c in 0..3 {
-                        let de = g * (nx[c] - un * e[c] / len);
-                        gb[c] += de;
-                        ga[c] -= de;
-                    }
-                }
-                if ia < trainable {
-                    contributions.push((ia, ga));
-                }
-                if ib < trainable {
-                    contributions.push((ib, gb));
-                }
+                surface_one(sites, x, nx, ia, ib, normal_weight, min_cos, trainable, &mut loss, &mut contributions);
             }
             (loss, contributions)
         })
