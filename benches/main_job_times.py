@@ -78,7 +78,27 @@ def main():
     if a.baseline:
         print("\nIn parentheses: baseline time / new time (> 1: faster now).")
     if a.json:
-        Path(a.json).write_text(json.dumps(rows, indent=1))
+        Path(a.json).write_text(json.dumps(flat(rows), indent=1))
+
+
+def flat(rows):
+    """The JSON file: `rows` with one flat row per mesh (`total_s`, `STAGE_s` and, beside a
+    baseline, `baseline_total_s`, `baseline_STAGE_s` and the ratios `speedup_total`,
+    `speedup_STAGE` = baseline / new), for the docs' figure tables; `runs` as measured."""
+    out = []
+    for r in rows:
+        f = {"mesh": r["mesh"], "total_s": r["new"]["total"], "misclassification": r["new"]["misclassification"]}
+        f.update({f"{s}_s": r["new"]["stages"][s] for s in STAGES})
+        b = r.get("baseline")
+        if b:
+            f["baseline_total_s"] = b["total"]
+            f["speedup_total"] = b["total"] / max(r["new"]["total"], 1e-9)
+            for s in STAGES:
+                f[f"baseline_{s}_s"] = b["stages"][s]
+                f[f"speedup_{s}"] = b["stages"][s] / max(r["new"]["stages"][s], 1e-9)
+            f["baseline_misclassification"] = b["misclassification"]
+        out.append(f)
+    return {"rows": out, "runs": rows}
 
 
 if __name__ == "__main__":

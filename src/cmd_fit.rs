@@ -164,6 +164,9 @@ pub struct Args {
     /// √(8192/K); halved four times over the steps).
     #[arg(long)]
     pub polish_lr: Option<f64>,
+    /// Surface samples per polish step (default 20,000).
+    #[arg(long)]
+    pub polish_batch: Option<usize>,
     /// Weight of the polish's alignment term over its first half (nearest inside and
     /// outside sites of each surface sample turned along its normal, which lines the pairs
     /// up, for smoother normals on smooth shapes). Default: on a closed input the polish
@@ -175,7 +178,7 @@ pub struct Args {
     #[arg(long)]
     pub polish_align: Option<f64>,
     /// No surface polish after training.
-    #[arg(long, conflicts_with_all = ["polish_steps", "polish_lr", "polish_align"])]
+    #[arg(long, conflicts_with_all = ["polish_steps", "polish_lr", "polish_batch", "polish_align"])]
     pub no_polish: bool,
     /// Budget of sites for --target-hausdorff.
     #[arg(long, default_value_t = 131_072)]
@@ -261,6 +264,7 @@ impl Args {
                 no_polish: self.no_polish,
                 polish_steps: self.polish_steps,
                 polish_lr: self.polish_lr,
+                polish_batch: self.polish_batch,
                 polish_align: self.polish_align,
             },
             weld_tolerance: self.weld_tolerance,

@@ -73,6 +73,8 @@ pub struct FitOptions {
     pub polish_steps: Option<usize>,
     /// Polish learning rate (default 1e-3 at K = 8,192, scaled by √(8192/K)).
     pub polish_lr: Option<f64>,
+    /// Surface samples per polish step (default 20,000).
+    pub polish_batch: Option<usize>,
     /// Weight of the polish's alignment term (`soft_voronoi::polish::Alignment`): `None`
     /// (default), on a closed input the aligned polish (weight [`crate::TRY_ALIGNMENT_WEIGHT`]) is tried beside the plain
     /// one and its crust kept only where it is at least as good on all four metrics
@@ -135,6 +137,7 @@ impl FitOptions {
             let mut p = soft_voronoi::PolishConfig::default_for(k, self.seed);
             p.steps = self.polish_steps.unwrap_or(p.steps);
             p.lr = self.polish_lr.unwrap_or(p.lr);
+            p.batch = self.polish_batch.unwrap_or(p.batch);
             if let Some(w) = self.polish_align {
                 p.alignment =
                     (w > 0.0).then(|| soft_voronoi::polish::Alignment { normal_weight: w, ..Default::default() });

@@ -69,6 +69,7 @@ _FIT_OPTIONS = {
     "skip_metrics",
     "polish_steps",
     "polish_lr",
+    "polish_batch",
     "polish_align",
 }
 
@@ -332,7 +333,7 @@ def fit(
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell" | "flood"), shell_thickness, flood_cells,
             no_fill_holes (keep planar holes open), skip_metrics,
-            polish_steps (0: no polish), polish_lr, polish_align (None: on a closed mesh both
+            polish_steps (0: no polish), polish_lr, polish_batch, polish_align (None: on a closed mesh both
             polishes, the aligned crust kept where it is at least as good on all four metrics,
             Hausdorff distances both within the F-score's tau or with overlapping certified
             intervals counting as equal;
