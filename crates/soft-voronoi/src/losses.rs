@@ -416,9 +416,10 @@ fn surface_one(
 }
 
 /// [`surface_hinted`] where the caller already knows, for most samples, the nearest inside
-/// and outside site: `pairs[i]` is that pair when `known[i]`, else the pair is searched in
-/// `index` (built from `labels` on the first such sample). Same result as [`surface_hinted`], bit for
-/// bit: the polish finds the pairs among the 11 nearest sites it looks up anyway.
+/// and outside site: `pairs[i]` is that pair when its flag is set, else the pair is searched
+/// in `index` (built from `labels` on the first such sample). Same result as
+/// [`surface_hinted`], bit for bit: the polish finds the pairs among the 11 nearest sites it
+/// looks up anyway.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn surface_paired(
     index: &std::sync::OnceLock<LabelledIndex>,
@@ -426,36 +427,20 @@ pub(crate) fn surface_paired(
     sites: &[[f64; 3]],
     points: &[[f64; 3]],
     normals: &[[f64; 3]],
-    pairs: &[([u32; 2], bool)],
+    pairs: &mut [([u32; 2], bool)],
     normal_weight: f64,
     min_cos: f64,
     weight: f64,
     grad: &mut [[f64; 3]],
 ) -> f64 {
-    let m = points.len().max(1) as f64;
-    let trainable = grad.len() as u32;
-    let parts: Vec<ChunkPart<3>> = points
-        .par_chunks(CHUNK)
-        .zip(normals.par_chunks(CHUNK))
-        .zip(pairs.par_chunks(CHUNK))
-        .map(|((xs, ns), ps)| {
-            let mut contributions = Vec::with_capacity(2 * xs.len());
-            let mut loss = 0.0;
-            for ((&x, &nx), &(pair, known)) in xs.iter().zip(ns).zip(ps) {
-                let (ia, ib) = if known {
-                    (pair[0], pair[1])
-                } else {
-                    match index.get_or_init(|| LabelledIndex::new(sites, labels)).nearest_pair(sites, x) {
-                        Some(p) => p,
-                        None => continue,
-                    }
-                };
-                surface_one(sites, x, nx, ia, ib, normal_weight, min_cos, trainable, &mut loss, &mut contributions);
-            }
-            (loss, contributions)
-        })
-        .collect();
-    reduce(parts, weight / m, grad) / m
+    let pair = |&mut (p, known): &mut ([u32; 2], bool), x: [f64; 3]| {
+        if known {
+            Some((p[0], p[1]))
+        } else {
+            index.get_or_init(|| LabelledIndex::new(sites, labels)).nearest_pair(sites, x)
+        }
+    };
+    surface_sum(sites, points, normals, pairs, pair, normal_weight, min_cos, weight, grad)
 }
 
 /// [`surface`] warm-started: `hints` holds, per point, an inside and an outside site that
@@ -473,17 +458,36 @@ pub fn surface_hinted(
     weight: f64,
     grad: &mut [[f64; 3]],
 ) -> f64 {
+    let pair = |h: &mut [u32; 2], x: [f64; 3]| index.nearest_pair_hinted(sites, x, h);
+    surface_sum(sites, points, normals, hints, pair, normal_weight, min_cos, weight, grad)
+}
+
+/// The surface term over `points`, each sample's nearest inside and outside site given by
+/// `pair` from its own entry of `per_point` (a hint it may update, or a known pair); chunks
+/// of [`CHUNK`] samples, summed in order.
+#[allow(clippy::too_many_arguments)]
+fn surface_sum<P: Send>(
+    sites: &[[f64; 3]],
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    per_point: &mut [P],
+    pair: impl Fn(&mut P, [f64; 3]) -> Option<(u32, u32)> + Sync,
+    normal_weight: f64,
+    min_cos: f64,
+    weight: f64,
+    grad: &mut [[f64; 3]],
+) -> f64 {
     let m = points.len().max(1) as f64;
     let trainable = grad.len() as u32;
     let parts: Vec<ChunkPart<3>> = points
         .par_chunks(CHUNK)
         .zip(normals.par_chunks(CHUNK))
-        .zip(hints.par_chunks_mut(CHUNK))
-        .map(|((xs, ns), hs)| {
+        .zip(per_point.par_chunks_mut(CHUNK))
+        .map(|((xs, ns), ps)| {
             let mut contributions = Vec::with_capacity(2 * xs.len());
             let mut loss = 0.0;
-            for ((&x, &nx), h) in xs.iter().zip(ns).zip(hs) {
-                let Some((ia, ib)) = index.nearest_pair_hinted(sites, x, h) else { continue };
+            for ((&x, &nx), p) in xs.iter().zip(ns).zip(ps) {
+                let Some((ia, ib)) = pair(p, x) else { continue };
                 surface_one(sites, x, nx, ia, ib, normal_weight, min_cos, trainable, &mut loss, &mut contributions);
             }
             (loss, contributions)

@@ -420,7 +420,7 @@ pub fn polish(
         }
         grad.iter_mut().for_each(|g| *g = [0.0; 3]);
         let active = alignment.filter(|(_, _, a)| (t as f64) < a.share * config.steps as f64);
-        let (mut loss, pairs) =
+        let (mut loss, mut pairs) =
             voroloss_on_grid(sites, &batch, config.neighbours, cell, active.map(|(l, _, _)| l), &mut grad);
         if let Some((labels, _, a)) = active {
             // The term is d² + (normal / distance) · (1 − (u·n)²), times distance. The
@@ -435,7 +435,7 @@ pub fn polish(
                 sites,
                 &batch,
                 &batch_normals,
-                &pairs,
+                &mut pairs,
                 ratio,
                 a.min_cos,
                 a.distance_weight,
