@@ -244,10 +244,40 @@ fn voroloss_on_grid(
     if sites.len() < 2 || points.is_empty() {
         return (0.0, vec![([NO_HINT; 2], false); if labels.is_some() { points.len() } else { 0 }]);
     }
-    let grid = KnnGrid::new(sites, cell);
-    let want = (neighbours + 1).min(sites.len());
+    let parts = sample_parts(sites, points, neighbours, cell, labels);
     let trainable = grad.len();
     let n = points.len() as f64;
+    let mut loss = 0.0;
+    for chunk in parts.chunks(CHUNK) {
+        let mut l = 0.0;
+        for part in chunk {
+            let Some((d, [i, j], [ji, jj])) = part.bisector else { continue };
+            l += d * d;
+            for (k, jac) in [(i, ji), (j, jj)] {
+                if (k as usize) < trainable {
+                    for c in 0..3 {
+                        grad[k as usize][c] += 2.0 * d * jac[c] / n;
+                    }
+                }
+            }
+        }
+        loss += l;
+    }
+    let pairs = if labels.is_some() { parts.iter().map(|p| p.pair).collect() } else { Vec::new() };
+    (loss / n, pairs)
+}
+
+/// Every point's [`Sample`] against `sites` (at least two), in the points' order, the
+/// neighbours found on a [`KnnGrid`] of cells `cell` wide.
+fn sample_parts(
+    sites: &[[f64; 3]],
+    points: &[[f64; 3]],
+    neighbours: usize,
+    cell: f64,
+    labels: Option<&[bool]>,
+) -> Vec<Sample> {
+    let grid = KnnGrid::new(sites, cell);
+    let want = (neighbours + 1).min(sites.len());
     // The samples are looked up in the order of their cells, so that consecutive lookups
     // read the same cells (a random order missed the cache on most runs of points; 1.6×
     // faster measured on the multibody polish). Each sample's part is put back in place and
@@ -271,29 +301,12 @@ fn voroloss_on_grid(
     for (at, part) in found.into_iter().flatten() {
         parts[at as usize] = part;
     }
-    let mut loss = 0.0;
-    for chunk in parts.chunks(CHUNK) {
-        let mut l = 0.0;
-        for part in chunk {
-            let Some((d, [i, j], [gi, gj])) = part.bisector else { continue };
-            l += d * d;
-            for (k, g) in [(i, gi), (j, gj)] {
-                if (k as usize) < trainable {
-                    for c in 0..3 {
-                        grad[k as usize][c] += g[c] / n;
-                    }
-                }
-            }
-        }
-        loss += l;
-    }
-    let pairs = if labels.is_some() { parts.iter().map(|p| p.pair).collect() } else { Vec::new() };
-    (loss / n, pairs)
+    parts
 }
 
-/// One surface sample's part of VoroLoss: its signed distance to the nearest bisector, the
-/// two sites (nearest, neighbour) and their gradients of d² (`None`: every neighbour
-/// coincides with the nearest site), and its [`Pair`].
+/// One surface sample's part of VoroLoss: its signed distance d to the nearest bisector, the
+/// two sites (nearest, neighbour) and the gradients of d with respect to them (`None`: every
+/// neighbour coincides with the nearest site), and its [`Pair`].
 #[derive(Clone, Copy)]
 struct Sample {
     bisector: Option<(f64, [u32; 2], [[f64; 3]; 2])>,
@@ -315,7 +328,7 @@ fn sample_part(
     want: usize,
     labels: Option<&[bool]>,
     near: &mut Vec<(f64, u32)>,
-    buf: &mut Vec<(f64, u32)>,
+    buf: &mut Vec<u128>,
 ) -> Sample {
     // Exact f64 distances, ties by index: the result does not depend on the grid.
     grid.k_nearest_with(x, want, near, buf);
@@ -351,9 +364,9 @@ fn sample_part(
         // ∂d/∂p_j = −u/2 + t, ∂d/∂p_i = −u/2 − t, with t = (r − d u)/|e| (the turn of u);
         // the loss takes 2d times these.
         let t = [0, 1, 2].map(|c| (r[c] - d * u[c]) / len);
-        let gi = [0, 1, 2].map(|c| 2.0 * d * (-0.5 * u[c] - t[c]));
-        let gj = [0, 1, 2].map(|c| 2.0 * d * (-0.5 * u[c] + t[c]));
-        part.bisector = Some((d, [i as u32, j as u32], [gi, gj]));
+        let ji = [0, 1, 2].map(|c| -0.5 * u[c] - t[c]);
+        let jj = [0, 1, 2].map(|c| -0.5 * u[c] + t[c]);
+        part.bisector = Some((d, [i as u32, j as u32], [ji, jj]));
     }
     part
 }
