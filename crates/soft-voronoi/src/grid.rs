@@ -28,7 +28,7 @@ const MAX_CELLS: usize = 1 << 22;
 
 /// A uniform grid over a fixed set of 3D points, with a k-d tree for the queries the grid
 /// cannot answer alone.
-pub struct KnnGrid<'a> {
+pub struct KnnGrid {
     lo: [f64; 3],
     cell: f64,
     inv: f64,
@@ -39,14 +39,14 @@ pub struct KnnGrid<'a> {
     /// distances are computed several at a time).
     coords: [Vec<f64>; 3],
     ids: Vec<u32>,
-    source: &'a [[f64; 3]],
+    source: Vec<[f64; 3]>,
     tree: OnceLock<KnnTree>,
 }
 
-impl<'a> KnnGrid<'a> {
+impl KnnGrid {
     /// The grid over `points` (finite coordinates) with cells about `cell` wide (coarser
     /// when that would make more than [`MAX_CELLS`] cells); ids are the points' indices.
-    pub fn new(points: &'a [[f64; 3]], cell: f64) -> Self {
+    pub fn new(points: &[[f64; 3]], cell: f64) -> Self {
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in points {
             for c in 0..3 {
@@ -74,7 +74,7 @@ impl<'a> KnnGrid<'a> {
             starts: Vec::new(),
             coords: [Vec::new(), Vec::new(), Vec::new()],
             ids: Vec::new(),
-            source: points,
+            source: points.to_vec(),
             tree: OnceLock::new(),
         };
         // Counting sort of the points by cell.
@@ -142,26 +142,8 @@ impl<'a> KnnGrid<'a> {
         }
         let c = self.cell_of(x);
         for ring in 1..=MAX_RING {
-            let from = c.map(|v| v.saturating_sub(ring));
-            let to = [0, 1, 2].map(|a| (c[a] + ring).min(self.dims[a] - 1));
-            // Every point outside the block lies beyond one of its walls; a wall at the
-            // grid's edge has no point beyond it. The walls are moved towards x by a margin
-            // far above the rounding of `cell_of` and of the distances.
-            const SLACK: f64 = 1e-9;
-            let mut wall = f64::INFINITY;
-            for a in 0..3 {
-                if from[a] > 0 {
-                    wall = wall.min(x[a] - (self.lo[a] + from[a] as f64 * self.cell));
-                }
-                if to[a] + 1 < self.dims[a] {
-                    wall = wall.min(self.lo[a] + (to[a] + 1) as f64 * self.cell - x[a]);
-                }
-            }
+            let Some((from, to, wall)) = self.block(x, c, ring) else { continue };
             let whole = wall.is_infinite();
-            let wall = wall - SLACK;
-            if !whole && wall <= 0.0 {
-                continue;
-            }
             // Kept: squared distance strictly below this (every point when the block is
             // the whole grid).
             let keep = if whole { f64::INFINITY } else { wall * wall * (1.0 - 1e-12) };
@@ -184,8 +166,126 @@ impl<'a> KnnGrid<'a> {
                 return true;
             }
         }
-        self.tree.get_or_init(|| KnnTree::new(self.source)).k_nearest(x, k, out);
+        self.tree.get_or_init(|| KnnTree::new(&self.source)).k_nearest(x, k, out);
         false
+    }
+
+    /// The block of cells within `ring` of cell `c` (x's): its first and last cell and
+    /// the distance from x to its nearest wall, less a margin far above the rounding of
+    /// `cell_of` and of the distances (infinite when the block is the whole grid: a wall at
+    /// the grid's edge has no point beyond it). Every point outside the block is farther
+    /// from x than that. `None` when x is within the margin of a wall.
+    fn block(&self, x: [f64; 3], c: [usize; 3], ring: usize) -> Option<([usize; 3], [usize; 3], f64)> {
+        const SLACK: f64 = 1e-9;
+        let from = c.map(|v| v.saturating_sub(ring));
+        let to = [0, 1, 2].map(|a| (c[a] + ring).min(self.dims[a] - 1));
+        let mut wall = f64::INFINITY;
+        for a in 0..3 {
+            if from[a] > 0 {
+                wall = wall.min(x[a] - (self.lo[a] + from[a] as f64 * self.cell));
+            }
+            if to[a] + 1 < self.dims[a] {
+                wall = wall.min(self.lo[a] + (to[a] + 1) as f64 * self.cell - x[a]);
+            }
+        }
+        if wall.is_infinite() {
+            return Some((from, to, wall));
+        }
+        let wall = wall - SLACK;
+        (wall > 0.0).then_some((from, to, wall))
+    }
+
+    /// Calls `f(squared distance, index)` for every point in the cells `from` … `to`.
+    #[inline]
+    fn scan(&self, x: [f64; 3], from: [usize; 3], to: [usize; 3], mut f: impl FnMut(f64, u32)) {
+        let [px, py, pz] = &self.coords;
+        for z in from[2]..=to[2] {
+            for y in from[1]..=to[1] {
+                let a = self.starts[self.cell_id([from[0], y, z])] as usize;
+                let b = self.starts[self.cell_id([to[0], y, z]) + 1] as usize;
+                for i in a..b {
+                    f(d2(x, [px[i], py[i], pz[i]]), self.ids[i]);
+                }
+            }
+        }
+    }
+
+    /// The soft-Voronoi kernel's candidate query ([`KnnTree::window`], answered on the
+    /// grid): every point within `d_min + window` of `x`, d_min the nearest point's
+    /// distance, into `out` as (index, distance) in no set order, and d_min. Distances
+    /// are `d2(x, p).sqrt()`, as the tree computes them, so the set and the distances are
+    /// the tree's. `None` (with `out` unspecified) when the blocks up to [`MAX_RING`]
+    /// cells around x cannot tell: d_min + window reaches beyond them. `start` is a
+    /// distance known to be ≥ d_min (a site's that was near x before, or infinity: none
+    /// known): a block whose walls are nearer than `start + window` is likely not to tell
+    /// and is skipped, and when every block is, the grid gives up at once.
+    pub fn window(&self, x: [f64; 3], window: f64, start: f64, out: &mut Vec<(u32, f64)>) -> Option<f64> {
+        if self.ids.is_empty() {
+            return None;
+        }
+        let c = self.cell_of(x);
+        for ring in 1..=MAX_RING {
+            let Some((from, to, wall)) = self.block(x, c, ring) else { continue };
+            if start.is_finite() && start + window >= wall {
+                continue;
+            }
+            out.clear();
+            let mut best = f64::INFINITY;
+            // The tree's prefilter: squared distances above the padded square of the
+            // current radius are certainly outside it.
+            let mut r2 = f64::INFINITY;
+            self.scan(x, from, to, |q, id| {
+                if q > r2 {
+                    return;
+                }
+                let d = q.sqrt();
+                if d <= best + window {
+                    out.push((id, d));
+                    if d < best {
+                        best = d;
+                        r2 = crate::knn::pad2(best + window);
+                    }
+                }
+            });
+            if best + window < wall {
+                out.retain(|c| c.1 <= best + window);
+                return Some(best);
+            }
+        }
+        None
+    }
+
+    /// The nearest point labelled `true` and the nearest labelled `false` (`labels` has
+    /// one entry per point), each as (squared distance, index) with ties by index, as
+    /// [`KnnTree::nearest_within`] finds them on each side's own tree. `None` when the
+    /// blocks up to [`MAX_RING`] cells around x cannot tell (a side's nearest point may
+    /// lie beyond them, or a side has none there). `reach`: a squared distance within
+    /// which both are known to lie (or infinity); blocks whose walls are nearer are skipped,
+    /// as in [`KnnGrid::window`].
+    pub fn nearest_by_label(&self, x: [f64; 3], labels: &[bool], reach: f64) -> Option<[(f64, u32); 2]> {
+        if self.ids.is_empty() {
+            return None;
+        }
+        let c = self.cell_of(x);
+        for ring in 1..=MAX_RING {
+            let Some((from, to, wall)) = self.block(x, c, ring) else { continue };
+            if reach.is_finite() && reach >= wall * wall {
+                continue;
+            }
+            let mut best = [(f64::INFINITY, u32::MAX); 2];
+            self.scan(x, from, to, |q, id| {
+                let b = &mut best[usize::from(labels[id as usize])];
+                if q < b.0 || (q == b.0 && id < b.1) {
+                    *b = (q, id);
+                }
+            });
+            // Nearer than every point beyond the walls (as in `k_nearest_with`).
+            let keep = if wall.is_infinite() { f64::INFINITY } else { wall * wall * (1.0 - 1e-12) };
+            if best.iter().all(|b| b.1 != u32::MAX && b.0 < keep) {
+                return Some([best[1], best[0]]);
+            }
+        }
+        None
     }
 
     /// [`KnnGrid::k_nearest_with`] with its own scratch space.
@@ -277,6 +377,68 @@ mod tests {
         }
     }
 
+    proptest! {
+        /// The kernel's candidate query: whenever the grid answers, it is the tree's answer
+        /// (the same nearest distance, the same sites at the same distances), whatever the
+        /// start distance it was given.
+        #[test]
+        fn window_equals_the_tree(
+            points in prop::collection::vec([coord(), coord(), coord()], 1..300),
+            queries in prop::collection::vec([coord(), coord(), coord()], 1..20),
+            window in prop_oneof![Just(0.0), 0.0f64..0.2],
+            cell in prop_oneof![Just(0.125), 0.01f64..0.5],
+            hint in 0usize..300,
+        ) {
+            let tree = KnnTree::new(&points);
+            let grid = KnnGrid::new(&points, cell);
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            for &x in &queries {
+                let mut kn = Vec::new();
+                tree.k_nearest(x, 1, &mut kn);
+                let nearest = kn[0].0.sqrt();
+                let start = d2(x, points[hint % points.len()]).sqrt();
+                for start in [nearest, start, f64::INFINITY] {
+                    let da = tree.window(x, window, start, &mut a);
+                    if let Some(db) = grid.window(x, window, start, &mut b) {
+                        a.sort_unstable_by_key(|c| c.0);
+                        b.sort_unstable_by_key(|c| c.0);
+                        prop_assert_eq!(da, db);
+                        prop_assert_eq!(&a, &b);
+                    }
+                }
+            }
+        }
+
+        /// The nearest site of each label: whenever the grid answers, it is what each side's
+        /// own tree finds (ties by index).
+        #[test]
+        fn nearest_by_label_equals_the_trees(
+            points in prop::collection::vec(([coord(), coord(), coord()], any::<bool>()), 1..300),
+            queries in prop::collection::vec([coord(), coord(), coord()], 1..20),
+            cell in prop_oneof![Just(0.125), 0.01f64..0.5],
+        ) {
+            let sites: Vec<[f64; 3]> = points.iter().map(|p| p.0).collect();
+            let labels: Vec<bool> = points.iter().map(|p| p.1).collect();
+            let side = |l: bool| -> (Vec<u32>, KnnTree) {
+                let ids: Vec<u32> = (0..sites.len() as u32).filter(|&i| labels[i as usize] == l).collect();
+                let tree = KnnTree::new(&ids.iter().map(|&i| sites[i as usize]).collect::<Vec<_>>());
+                (ids, tree)
+            };
+            let (inside, outside) = (side(true), side(false));
+            let grid = KnnGrid::new(&sites, cell);
+            for &x in &queries {
+                for reach in [f64::INFINITY, 0.01, 1e-6] {
+                    if let Some([a, b]) = grid.nearest_by_label(x, &labels, reach) {
+                        for ((ids, tree), got) in [(&inside, a), (&outside, b)] {
+                            let (d, local) = tree.nearest_within(x, f64::INFINITY).unwrap();
+                            prop_assert_eq!((d, ids[local as usize]), got);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// On evenly spread points with the cell from [`cell_for`], most queries never reach
     /// the tree (so the grid is doing the work, not the fallback).
     #[test]
@@ -298,5 +460,16 @@ mod tests {
             assert_eq!(a, b);
         }
         assert!(alone > 3000, "the grid answered {alone} of 4000 alone");
+        // The kernel's candidate query with a narrow window, started from the nearest
+        // distance as a hint gives it: the grid answers most alone too.
+        let mut out = Vec::new();
+        let answered = queries
+            .iter()
+            .filter(|&&x| {
+                tree.k_nearest(x, 1, &mut b);
+                grid.window(x, 1e-3, b[0].0.sqrt(), &mut out).is_some()
+            })
+            .count();
+        assert!(answered > 3000, "the grid answered {answered} of 4000 window queries");
     }
 }

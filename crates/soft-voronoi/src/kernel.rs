@@ -28,6 +28,7 @@ use std::sync::OnceLock;
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 
+use crate::grid::KnnGrid;
 use crate::knn::KnnTree;
 
 /// No hint: the sample has not been seen, or its last nearest site is unknown.
@@ -67,16 +68,46 @@ impl Kernel {
 /// were most of a training step. The plain nearest query (hard labels of many points)
 /// runs on kiddo's `ImmutableKdTree` (bucket size 32, SIMD leaf scans), built the first
 /// time it is asked for.
+///
+/// With a cell width ([`SiteIndex::with_cell`], 3D only) the candidate query is first
+/// tried on a uniform grid ([`KnnGrid::window`]): near the surface, where the sites are
+/// dense and evenly spread, the block of cells around a sample holds its candidates, and
+/// scanning a few contiguous runs beats descending the tree (the training's queries were
+/// most of its time). Where the grid cannot tell (a sample far from every site), the tree
+/// answers, built the first time it is needed. The answer is the same either way.
 pub struct SiteIndex<const D: usize = 3> {
-    knn: KnnTree<D>,
+    knn: OnceLock<KnnTree<D>>,
     kiddo: OnceLock<ImmutableKdTree<f64, u32, D, 32>>,
+    grid: Option<KnnGrid>,
     points: Vec<[f64; D]>,
 }
 
 impl<const D: usize> SiteIndex<D> {
     /// Builds the index over `sites` (finite coordinates; at least one site).
     pub fn new(sites: &[[f64; D]]) -> Self {
-        SiteIndex { knn: KnnTree::new(sites), kiddo: OnceLock::new(), points: sites.to_vec() }
+        let knn = OnceLock::new();
+        let _ = knn.set(KnnTree::new(sites));
+        SiteIndex { knn, kiddo: OnceLock::new(), grid: None, points: sites.to_vec() }
+    }
+
+    /// [`SiteIndex::new`] with a grid of cells about `cell` wide in front of the tree
+    /// (see the type's documentation; in 3D only, elsewhere the same as `new`). The cell
+    /// width sets only the speed.
+    pub fn with_cell(sites: &[[f64; D]], cell: f64) -> Self {
+        if D != 3 || !(cell.is_finite() && cell > 0.0) {
+            return Self::new(sites);
+        }
+        let sites3: Vec<[f64; 3]> = sites.iter().map(|&p| to3(p)).collect();
+        SiteIndex {
+            knn: OnceLock::new(),
+            kiddo: OnceLock::new(),
+            grid: Some(KnnGrid::new(&sites3, cell)),
+            points: sites.to_vec(),
+        }
+    }
+
+    fn tree(&self) -> &KnnTree<D> {
+        self.knn.get_or_init(|| KnnTree::new(&self.points))
     }
 
     /// Number of indexed sites.
@@ -120,13 +151,27 @@ impl<const D: usize> SiteIndex<D> {
             Some(&p) => distance(x, p),
             _ => f64::INFINITY,
         };
-        let d_min = self.knn.window(x, window, start, out);
+        let on_grid = self.grid.as_ref().and_then(|g| g.window(to3(x), window, start, out));
+        let d_min = match on_grid {
+            Some(d) => d,
+            None => self.tree().window(x, window, start, out),
+        };
         out.sort_unstable_by_key(|c| c.0);
         if let Some(c) = out.iter().find(|c| c.1 == d_min) {
             *hint = c.0;
         }
         d_min
     }
+}
+
+/// The first three coordinates of a `D`-dimensional point (zeros beyond `D`): the grid's
+/// point for [`SiteIndex::with_cell`], which builds a grid only when `D` is 3.
+#[inline]
+fn to3<const D: usize>(p: [f64; D]) -> [f64; 3] {
+    let mut q = [0.0; 3];
+    let n = D.min(3);
+    q[..n].copy_from_slice(&p[..n]);
+    q
 }
 
 /// Euclidean distance in `D` dimensions: the square root of [`crate::knn::d2`], so the

@@ -237,7 +237,7 @@ pub fn d2<const D: usize>(x: [f64; D], p: [f64; D]) -> f64 {
 
 /// r² padded up by a relative 1e-12: a squared distance above it has a square root above r.
 #[inline]
-fn pad2(r: f64) -> f64 {
+pub(crate) fn pad2(r: f64) -> f64 {
     r * r * (1.0 + 1e-12)
 }
 

@@ -5,8 +5,10 @@
 
 use rayon::prelude::*;
 
+use crate::grid::KnnGrid;
 use crate::kernel::{self, Kernel, Scratch, SiteIndex, NO_HINT};
 use crate::knn::{self, KnnTree};
+use std::sync::OnceLock;
 
 /// Samples per parallel chunk (fixed: the reduction order depends on it).
 pub const CHUNK: usize = 1024;
@@ -286,20 +288,35 @@ pub fn centroidal<const D: usize>(graph: &SiteGraph, sites: &[[f64; D]], weight:
     loss / k
 }
 
-/// Sites split by label, each side in its own k-d tree, for [`surface`].
+/// Sites split by label, each side in its own k-d tree, for [`surface`]. With a cell width
+/// ([`LabelledIndex::with_cell`]) a uniform grid over all sites answers first
+/// ([`KnnGrid::nearest_by_label`]: the block of cells around a sample near the surface
+/// holds the nearest site of each side), and the trees, built the first time they are
+/// needed, answer the rest. The answer is the same either way.
 pub struct LabelledIndex {
     /// Global indices of the inside sites.
     pub inside: Vec<u32>,
     /// Global indices of the outside sites.
     pub outside: Vec<u32>,
     labels: Vec<bool>,
-    inside_tree: KnnTree,
-    outside_tree: KnnTree,
+    /// Each side's sites, in the order of `inside` and `outside`.
+    points: [Vec<[f64; 3]>; 2],
+    inside_tree: OnceLock<KnnTree>,
+    outside_tree: OnceLock<KnnTree>,
+    grid: Option<KnnGrid>,
 }
 
 impl LabelledIndex {
     /// Indexes `sites` by `labels`.
     pub fn new(sites: &[[f64; 3]], labels: &[bool]) -> Self {
+        let index = Self::with_cell(sites, labels, f64::NAN);
+        rayon::join(|| index.tree(true), || index.tree(false));
+        index
+    }
+
+    /// [`LabelledIndex::new`] with a grid of cells about `cell` wide in front of the trees
+    /// (none when `cell` is not finite and positive); the cell width sets only the speed.
+    pub fn with_cell(sites: &[[f64; 3]], labels: &[bool], cell: f64) -> Self {
         let (mut inside, mut outside) = (Vec::new(), Vec::new());
         for (i, &l) in labels.iter().enumerate() {
             if l {
@@ -308,9 +325,24 @@ impl LabelledIndex {
                 outside.push(i as u32)
             }
         }
-        let tree = |ids: &[u32]| KnnTree::new(&ids.iter().map(|&i| sites[i as usize]).collect::<Vec<_>>());
-        let (inside_tree, outside_tree) = rayon::join(|| tree(&inside), || tree(&outside));
-        LabelledIndex { inside_tree, outside_tree, inside, outside, labels: labels.to_vec() }
+        let points = |ids: &[u32]| ids.iter().map(|&i| sites[i as usize]).collect::<Vec<_>>();
+        let grid = (cell.is_finite() && cell > 0.0).then(|| KnnGrid::new(sites, cell));
+        LabelledIndex {
+            points: [points(&inside), points(&outside)],
+            inside_tree: OnceLock::new(),
+            outside_tree: OnceLock::new(),
+            grid,
+            inside,
+            outside,
+            labels: labels.to_vec(),
+        }
+    }
+
+    /// The tree of the inside (`true`) or outside sites.
+    fn tree(&self, inside: bool) -> &KnnTree {
+        let (cell, points) =
+            if inside { (&self.inside_tree, &self.points[0]) } else { (&self.outside_tree, &self.points[1]) };
+        cell.get_or_init(|| KnnTree::new(points))
     }
 
     /// The nearest inside and the nearest outside site of `x` (global indices; ties by
@@ -323,6 +355,16 @@ impl LabelledIndex {
     /// site that were near `x` before, global indices, or [`NO_HINT`]), which are set to
     /// the answer; the answer does not depend on them. `sites` are the indexed ones.
     pub fn nearest_pair_hinted(&self, sites: &[[f64; 3]], x: [f64; 3], hints: &mut [u32; 2]) -> Option<(u32, u32)> {
+        // Both hints, when they carry their side's label, bound how far the grid must look.
+        let bound = |hint: u32, label: bool| match self.labels.get(hint as usize) {
+            Some(&l) if l == label => knn::d2(x, sites[hint as usize]),
+            _ => f64::INFINITY,
+        };
+        let reach = bound(hints[0], true).max(bound(hints[1], false));
+        if let Some([(_, a), (_, b)]) = self.grid.as_ref().and_then(|g| g.nearest_by_label(x, &self.labels, reach)) {
+            *hints = [a, b];
+            return Some((a, b));
+        }
         let side = |tree: &KnnTree, ids: &[u32], hint: &mut u32, label: bool| {
             // Any site of this side bounds the nearest one's squared distance (computed as
             // the tree computes it), so the search starts bounded.
@@ -335,8 +377,8 @@ impl LabelledIndex {
             Some(*hint)
         };
         let [hi, ho] = hints;
-        let a = side(&self.inside_tree, &self.inside, hi, true)?;
-        let b = side(&self.outside_tree, &self.outside, ho, false)?;
+        let a = side(self.tree(true), &self.inside, hi, true)?;
+        let b = side(self.tree(false), &self.outside, ho, false)?;
         Some((a, b))
     }
 }

@@ -197,6 +197,10 @@ pub struct Trainer<'a> {
     surface_ids: Vec<u32>,
     /// This step's hints, gathered from the pool and scattered back after the step.
     batch_hints: Hints,
+    /// Cell width of the grids in front of the trees ([`SiteIndex::with_cell`],
+    /// [`losses::LabelledIndex::with_cell`]); set by [`Trainer::refresh_cell`]. Only the
+    /// speed depends on it.
+    cell: f64,
 }
 
 impl<'a> Trainer<'a> {
@@ -319,8 +323,14 @@ impl<'a> Trainer<'a> {
             batch_ids: Vec::with_capacity(b),
             surface_ids: Vec::new(),
             batch_hints: Hints::new(0, 0),
+            cell: f64::NAN,
             state,
         }
+    }
+
+    /// Sets the grids' cell width from the current sites ([`grid_cell`]).
+    fn refresh_cell(&mut self) {
+        self.cell = grid_cell(&self.state.sites, self.data);
     }
 
     /// The total loss of the current sites on the fixed evaluation batch, at the final β
@@ -336,13 +346,16 @@ impl<'a> Trainer<'a> {
             surface: &batch.surface,
             normals: &batch.normals,
         };
-        objective(&self.state, &kernel, &sel, &mut batch.hints, &mut grad).total
+        objective(&self.state, &kernel, &sel, &mut batch.hints, self.cell, &mut grad).total
     }
 
     /// Measures the current sites on the evaluation batch and keeps them if they are the
     /// best so far (ties keep the earlier iterate).
     fn consider_current(&mut self) {
         let Some(mut batch) = self.selection.take() else { return };
+        if !self.cell.is_finite() {
+            self.refresh_cell();
+        }
         let loss = self.selection_loss(&mut batch);
         self.selection = Some(batch);
         let st = &mut self.state;
@@ -392,6 +405,9 @@ impl<'a> Trainer<'a> {
         let w = cfg.weights.clone();
         let (lr, beta) = (cfg.lr_at(t), cfg.beta_at(t));
         let kernel = Kernel { beta, tau: cfg.tau };
+        if t.is_multiple_of(cfg.refresh_every) || !self.cell.is_finite() {
+            self.cell = grid_cell(&st.sites, self.data);
+        }
         if t.is_multiple_of(cfg.refresh_every) || (w.centroidal > 0.0 && st.graph.num_sites() != st.sites.len()) {
             if w.centroidal > 0.0 {
                 st.graph = SiteGraph::delaunay(&st.sites)?;
@@ -438,7 +454,7 @@ impl<'a> Trainer<'a> {
             normals: &self.surface_normals,
         };
         let Terms { total, reconstruction: rec, bounds: bnd, signed_distance: sdf, centroidal: cen, surface: srf } =
-            objective(st, &kernel, &batch, &mut self.batch_hints, &mut self.grad);
+            objective(st, &kernel, &batch, &mut self.batch_hints, self.cell, &mut self.grad);
         for (&i, &h) in self.batch_ids.iter().zip(&self.batch_hints.points) {
             self.pool_hints.points[i as usize] = h;
         }
@@ -511,14 +527,24 @@ struct Terms {
 /// `grad` (the trainable sites'): the one definition a training step and the best-iterate
 /// selection share. The signed-distance and centroidal terms use the state's last refresh
 /// (closest points, Delaunay graph).
-fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, hints: &mut Hints, grad: &mut [[f64; 3]]) -> Terms {
+fn objective(
+    state: &TrainState,
+    kernel: &Kernel,
+    batch: &Batch,
+    hints: &mut Hints,
+    cell: f64,
+    grad: &mut [[f64; 3]],
+) -> Terms {
     let (sites, labels) = (&state.sites, &state.labels);
     let k = state.config.num_sites;
     let w = &state.config.weights;
     let wants_surface = w.surface > 0.0 && !batch.surface.is_empty();
-    // The three trees are built side by side (each build is serial).
-    let (index, labelled) =
-        rayon::join(|| SiteIndex::new(sites), || wants_surface.then(|| losses::LabelledIndex::new(sites, labels)));
+    // The two grids are built side by side (each build is serial); the trees behind them
+    // only when a query needs them.
+    let (index, labelled) = rayon::join(
+        || SiteIndex::with_cell(sites, cell),
+        || wants_surface.then(|| losses::LabelledIndex::with_cell(sites, labels, cell)),
+    );
     let rec = losses::reconstruction_hinted(
         kernel,
         &index,
@@ -563,6 +589,16 @@ fn objective(state: &TrainState, kernel: &Kernel, batch: &Batch, hints: &mut Hin
         centroidal: cen,
         surface: srf,
     }
+}
+
+/// The training grids' cell width: the 80th percentile, over surface samples (the training
+/// samples when there are none), of the distance to the fourth-nearest site. The grids'
+/// queries (the kernel's candidates, the nearest inside and outside site) then mostly end in
+/// the 3 × 3 × 3 cells around a sample near the surface; samples far from every site are
+/// left to the trees.
+fn grid_cell(sites: &[[f64; 3]], data: &TrainingData) -> f64 {
+    let points = if data.surface.is_empty() { &data.points } else { &data.surface };
+    crate::grid::cell_for(sites, points, 4.min(sites.len()))
 }
 
 /// Hard Voronoi occupancy (nearest site's label) of each point, in parallel.
