@@ -8,6 +8,15 @@ use soft_voronoi::{Init, TrainConfig};
 use crate::config::{FitConfig, SolidRule, DEFAULT_SITES};
 use crate::error::FitError;
 
+/// `--preset fast`: training steps (the default's 200 halved).
+pub const FAST_STEPS: usize = 100;
+/// `--preset fast`: polish steps, one plain polish (the default runs a plain and an aligned
+/// one of 600 at K > 4,096 and keeps the better crust).
+pub const FAST_POLISH_STEPS: usize = 300;
+/// `--preset fast`: the training pool (the default's 1,000,000 quartered: its winding
+/// numbers are most of the sampling stage).
+pub const FAST_SAMPLES: usize = 250_000;
+
 /// What a user may set (every field optional: `None` or `false` keeps the default of
 /// [`FitConfig::new`] and [`TrainConfig::default_for`]). File paths, checkpoints and the
 /// output precision are the front end's business.
@@ -20,8 +29,10 @@ pub struct FitOptions {
     pub steps: Option<usize>,
     /// Seed of the samples, the initialisation and the batches.
     pub seed: u64,
-    /// `default` or `paper` (the seed paper's setting: no polish, no relabelling, no
-    /// insertion, no pruning).
+    /// `default`, `fast` (about half the time for a rougher crust: [`FAST_STEPS`],
+    /// [`FAST_POLISH_STEPS`] of one plain polish, [`FAST_SAMPLES`]; docs/performance.md)
+    /// or `paper` (the seed paper's setting: no polish, no relabelling, no insertion, no
+    /// pruning).
     pub preset: Option<String>,
     /// Initialisation.
     pub init: Option<Init>,
@@ -90,13 +101,15 @@ impl FitOptions {
     /// [`FitError::Settings`] or [`FitError::TrainSettings`] naming the bad option.
     pub fn to_config(&self, name: &str) -> Result<FitConfig, FitError> {
         let preset = self.preset.as_deref().unwrap_or("default");
-        let paper = match preset {
-            "default" => false,
-            "paper" => true,
-            other => return Err(FitError::Settings(format!("preset `{other}`: use `default` or `paper`"))),
+        let (paper, fast) = match preset {
+            "default" => (false, false),
+            "paper" => (true, false),
+            "fast" => (false, true),
+            other => return Err(FitError::Settings(format!("preset `{other}`: use `default`, `fast` or `paper`"))),
         };
         let mut c = FitConfig::new(name, self.sites.unwrap_or(DEFAULT_SITES));
-        c.sampling.samples = self.samples.unwrap_or(c.sampling.samples);
+        let fast_samples = fast.then_some(FAST_SAMPLES);
+        c.sampling.samples = self.samples.or(fast_samples).unwrap_or(c.sampling.samples);
         c.sampling.solid = self.solid;
         c.sampling.shell_thickness = self.shell_thickness;
         if let Some(n) = self.flood_cells {
@@ -116,6 +129,9 @@ impl FitOptions {
         c.skip_metrics = self.skip_metrics;
         let k = c.train.num_sites;
         let mut t = if paper { TrainConfig::paper(k) } else { TrainConfig::default_for(k) };
+        if fast {
+            t.steps = FAST_STEPS;
+        }
         t.steps = self.steps.unwrap_or(t.steps);
         t.init = self.init.unwrap_or(t.init);
         t.batch = self.batch.unwrap_or(t.batch);
@@ -135,6 +151,10 @@ impl FitOptions {
             None
         } else {
             let mut p = soft_voronoi::PolishConfig::default_for(k, self.seed);
+            if fast {
+                p.steps = FAST_POLISH_STEPS;
+                c.try_alignment = None;
+            }
             p.steps = self.polish_steps.unwrap_or(p.steps);
             p.lr = self.polish_lr.unwrap_or(p.lr);
             p.batch = self.polish_batch.unwrap_or(p.batch);
@@ -155,5 +175,45 @@ impl FitOptions {
         let c = c.with_seed(self.seed);
         c.validate()?;
         Ok(c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(o: FitOptions) -> FitConfig {
+        o.to_config("m").unwrap()
+    }
+
+    /// `fast` halves the training, polishes once (plain, shorter) and draws a smaller pool;
+    /// everything else is the default's, and a flag given beside it wins.
+    #[test]
+    fn the_fast_preset_and_flags_beside_it() {
+        let default = config(FitOptions::default());
+        let fast = config(FitOptions { preset: Some("fast".into()), ..Default::default() });
+        assert_eq!((default.train.steps, fast.train.steps), (200, FAST_STEPS));
+        assert_eq!(fast.sampling.samples, FAST_SAMPLES);
+        assert!(default.sampling.samples > FAST_SAMPLES);
+        let (dp, fp) = (default.polish.as_ref().unwrap(), fast.polish.as_ref().unwrap());
+        assert_eq!((dp.steps, fp.steps), (600, FAST_POLISH_STEPS));
+        assert!(default.try_alignment.is_some() && fast.try_alignment.is_none());
+        assert_eq!(fp.alignment, None);
+        assert_eq!((fast.carve, fast.relabel, fast.prune), (default.carve, default.relabel, default.prune));
+        assert_eq!(fast.preset, "fast");
+        let given = config(FitOptions {
+            preset: Some("fast".into()),
+            steps: Some(150),
+            samples: Some(500_000),
+            polish_steps: Some(450),
+            polish_align: Some(0.1),
+            ..Default::default()
+        });
+        assert_eq!((given.train.steps, given.sampling.samples), (150, 500_000));
+        let gp = given.polish.as_ref().unwrap();
+        assert_eq!(gp.steps, 450);
+        assert!(gp.alignment.is_some());
+        let bad = FitOptions { preset: Some("quick".into()), ..Default::default() }.to_config("m");
+        assert!(bad.unwrap_err().to_string().contains("`default`, `fast` or `paper`"));
     }
 }
