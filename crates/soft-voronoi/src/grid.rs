@@ -1,5 +1,9 @@
-//! Exact k nearest sites on a uniform grid, for the polish's dense queries: 20,000 surface
-//! samples a step, each asking for its 11 nearest sites.
+//! Exact nearest-site queries on a uniform grid: the polish's k nearest sites (20,000
+//! surface samples a step, each asking for its 11 nearest), and training's two queries,
+//! the soft-Voronoi kernel's candidate window ([`KnnGrid::window`]) and a surface sample's
+//! nearest inside and outside site ([`KnnGrid::nearest_by_label`]). The latter two return
+//! `None` where the cells around the sample cannot settle the answer, and the caller asks
+//! its k-d trees.
 //!
 //! Why not only [`KnnTree`]: a tree query descends from the root and backtracks through a
 //! dozen levels of branches for every sample, about 1.9 µs at K = 8,192, and the polish

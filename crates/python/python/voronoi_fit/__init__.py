@@ -329,7 +329,7 @@ def fit(
             ``voronoi-fit MESH`` writes); False keeps float64, as the CLI does for .obj and
             .ply outputs.
         **options: the CLI's other fit options by their long names: steps, preset
-            ("default" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
+            ("default" | "fast" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell" | "flood"), shell_thickness, flood_cells,
             no_fill_holes (keep planar holes open), skip_metrics,
