@@ -205,9 +205,7 @@ impl KnnGrid {
         let [px, py, pz] = &self.coords;
         for z in from[2]..=to[2] {
             for y in from[1]..=to[1] {
-                let a = self.starts[self.cell_id([from[0], y, z])] as usize;
-                let b = self.starts[self.cell_id([to[0], y, z]) + 1] as usize;
-                for i in a..b {
+                for i in self.run([from[0], y, z], to[0]) {
                     f(d2(x, [px[i], py[i], pz[i]]), self.ids[i]);
                 }
             }
@@ -297,14 +295,20 @@ impl KnnGrid {
         self.k_nearest_with(x, k, out, &mut Vec::new())
     }
 
+    /// The points of cells `from` … (`to_x`, from's y and z), one contiguous run of the
+    /// points in cell order.
+    #[inline]
+    fn run(&self, from: [usize; 3], to_x: usize) -> std::ops::Range<usize> {
+        self.starts[self.cell_id(from)] as usize..self.starts[self.cell_id([to_x, from[1], from[2]]) + 1] as usize
+    }
+
     /// Appends to `buf` the points of cells `from` … (`to_x`, from's y and z) (one
     /// contiguous run) whose squared distance to x is below `keep`, as [`d2`] computes it.
     #[inline]
     fn gather(&self, x: [f64; 3], keep: f64, from: [usize; 3], to_x: usize, buf: &mut Vec<u128>) {
-        let a = self.starts[self.cell_id(from)] as usize;
-        let b = self.starts[self.cell_id([to_x, from[1], from[2]]) + 1] as usize;
+        let r = self.run(from, to_x);
         let [px, py, pz] = &self.coords;
-        let (px, py, pz, ids) = (&px[a..b], &py[a..b], &pz[a..b], &self.ids[a..b]);
+        let (px, py, pz, ids) = (&px[r.clone()], &py[r.clone()], &pz[r.clone()], &self.ids[r]);
         let mut n = buf.len();
         buf.resize(n + ids.len(), 0);
         let slots = &mut buf[..];

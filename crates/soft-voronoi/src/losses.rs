@@ -355,30 +355,26 @@ impl LabelledIndex {
     /// site that were near `x` before, global indices, or [`NO_HINT`]), which are set to
     /// the answer; the answer does not depend on them. `sites` are the indexed ones.
     pub fn nearest_pair_hinted(&self, sites: &[[f64; 3]], x: [f64; 3], hints: &mut [u32; 2]) -> Option<(u32, u32)> {
-        // Both hints, when they carry their side's label, bound how far the grid must look.
+        // A hint that carries its side's label bounds that side's nearest squared distance
+        // (computed as the grid and the trees compute it): the grid skips the blocks that
+        // cannot hold both, and each tree's search starts bounded.
         let bound = |hint: u32, label: bool| match self.labels.get(hint as usize) {
             Some(&l) if l == label => knn::d2(x, sites[hint as usize]),
             _ => f64::INFINITY,
         };
-        let reach = bound(hints[0], true).max(bound(hints[1], false));
-        if let Some([(_, a), (_, b)]) = self.grid.as_ref().and_then(|g| g.nearest_by_label(x, &self.labels, reach)) {
-            *hints = [a, b];
-            return Some((a, b));
+        let bounds = [bound(hints[0], true), bound(hints[1], false)];
+        if let Some(grid) = &self.grid {
+            if let Some([(_, a), (_, b)]) = grid.nearest_by_label(x, &self.labels, bounds[0].max(bounds[1])) {
+                *hints = [a, b];
+                return Some((a, b));
+            }
         }
-        let side = |tree: &KnnTree, ids: &[u32], hint: &mut u32, label: bool| {
-            // Any site of this side bounds the nearest one's squared distance (computed as
-            // the tree computes it), so the search starts bounded.
-            let bound2 = match self.labels.get(*hint as usize) {
-                Some(&l) if l == label => knn::d2(x, sites[*hint as usize]),
-                _ => f64::INFINITY,
-            };
-            let (_, local) = tree.nearest_within(x, bound2)?;
-            *hint = ids[local as usize];
-            Some(*hint)
-        };
-        let [hi, ho] = hints;
-        let a = side(self.tree(true), &self.inside, hi, true)?;
-        let b = side(self.tree(false), &self.outside, ho, false)?;
+        let side =
+            |tree: &KnnTree, ids: &[u32], bound2: f64| tree.nearest_within(x, bound2).map(|(_, l)| ids[l as usize]);
+        let a = side(self.tree(true), &self.inside, bounds[0])?;
+        hints[0] = a;
+        let b = side(self.tree(false), &self.outside, bounds[1])?;
+        hints[1] = b;
         Some((a, b))
     }
 }

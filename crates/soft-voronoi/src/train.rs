@@ -398,6 +398,9 @@ impl<'a> Trainer<'a> {
     }
 
     fn update(&mut self) -> Result<StepStats, TrainError> {
+        if self.state.step.is_multiple_of(self.state.config.refresh_every) || !self.cell.is_finite() {
+            self.refresh_cell();
+        }
         let st = &mut self.state;
         let cfg = &st.config;
         let t = st.step;
@@ -405,9 +408,6 @@ impl<'a> Trainer<'a> {
         let w = cfg.weights.clone();
         let (lr, beta) = (cfg.lr_at(t), cfg.beta_at(t));
         let kernel = Kernel { beta, tau: cfg.tau };
-        if t.is_multiple_of(cfg.refresh_every) || !self.cell.is_finite() {
-            self.cell = grid_cell(&st.sites, self.data);
-        }
         if t.is_multiple_of(cfg.refresh_every) || (w.centroidal > 0.0 && st.graph.num_sites() != st.sites.len()) {
             if w.centroidal > 0.0 {
                 st.graph = SiteGraph::delaunay(&st.sites)?;
