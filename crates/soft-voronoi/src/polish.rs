@@ -61,6 +61,10 @@ const CHUNK: usize = 1024;
 ///   sponge 6.31 → 7.70%), so small K keeps 400.
 pub const POLISH_STEPS_ABOVE: usize = 4096;
 
+/// Steps whose VoroLoss is averaged into [`PolishReport::loss_tail`] (one batch's loss is
+/// noisy; 20 batches are 400,000 samples at the default batch).
+pub const TAIL_STEPS: usize = 20;
+
 /// Settings of the polish.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PolishConfig {
@@ -203,6 +207,10 @@ pub struct PolishReport {
     pub loss_first: f64,
     /// See `loss_first`.
     pub loss_last: f64,
+    /// Mean VoroLoss of the last [`TAIL_STEPS`] steps (fewer when fewer ran), the
+    /// alignment term left out: where the polish ended, less noisy than `loss_last`.
+    #[serde(default)]
+    pub loss_tail: f64,
     /// Root mean square and largest distance a site moved, unit-cube lengths.
     pub move_rms: f64,
     /// See `move_rms`.
@@ -397,6 +405,7 @@ pub fn polish(
         batch: config.batch,
         loss_first: f64::NAN,
         loss_last: f64::NAN,
+        loss_tail: f64::NAN,
         move_rms: 0.0,
         move_max: 0.0,
         aligned: false,
@@ -420,6 +429,7 @@ pub fn polish(
     // the cube in the whole polish, so it stays about right; it sets only the speed).
     let cell = crate::grid::cell_for(sites, surface, (config.neighbours + 1).min(sites.len()));
     const EPS: f64 = 1e-9;
+    let mut tail = [0.0; TAIL_STEPS];
     for t in 0..config.steps {
         let mut rng = ChunkRng::for_chunk(config.seed, Stream::PolishBatch, t as u64);
         batch.clear();
@@ -435,6 +445,7 @@ pub fn polish(
         let active = alignment.filter(|(_, _, a)| (t as f64) < a.share * config.steps as f64);
         let (mut loss, mut pairs) =
             voroloss_on_grid(sites, &batch, config.neighbours, cell, active.map(|(l, _, _)| l), &mut grad);
+        tail[t % TAIL_STEPS] = loss;
         if let Some((labels, _, a)) = active {
             // The term is d² + (normal / distance) · (1 − (u·n)²), times distance. The
             // nearest inside and outside sites come from VoroLoss's lookup where it saw
@@ -477,6 +488,11 @@ pub fn polish(
         if !on_step(t + 1, config.steps, loss) {
             break;
         }
+    }
+    // Summed in a fixed order (the ring's), so it depends on nothing but the losses.
+    let ran = report.steps.min(TAIL_STEPS);
+    if ran > 0 {
+        report.loss_tail = tail[..ran].iter().sum::<f64>() / ran as f64;
     }
     let moves: Vec<f64> = sites[..trainable].iter().zip(&start).map(|(a, b)| crate::kernel::distance(*a, *b)).collect();
     report.move_rms = (moves.iter().map(|d| d * d).sum::<f64>() / moves.len() as f64).sqrt();
@@ -558,6 +574,29 @@ mod tests {
         assert!(report.loss_last < 0.05 * report.loss_first, "{report:?}");
         assert_eq!(sites[2], start[2]);
         assert_eq!(run(2).0, sites);
+    }
+
+    /// `loss_tail` is the mean of the last [`TAIL_STEPS`] losses the polish reported (all of
+    /// them when it ran fewer steps).
+    #[test]
+    fn the_tail_loss_is_the_mean_of_the_last_steps() {
+        let mut s = 5u64;
+        let surface: Vec<[f64; 3]> =
+            (0..500).map(|_| [0.3 + 0.4 * lcg(&mut s), 0.3 + 0.4 * lcg(&mut s), 0.5]).collect();
+        for steps in [7, TAIL_STEPS, 53] {
+            let mut sites = vec![[0.5, 0.5, 0.45], [0.5, 0.5, 0.75], [0.4, 0.6, 0.7]];
+            let config = PolishConfig { steps, lr: 2e-3, batch: 64, ..PolishConfig::default_for(3, 2) };
+            let mut losses = Vec::new();
+            let r = polish(&mut sites, 3, &surface, None, &config, |_, _, l| {
+                losses.push(l);
+                true
+            })
+            .unwrap();
+            let last = &losses[losses.len().saturating_sub(TAIL_STEPS)..];
+            let mean = last.iter().sum::<f64>() / last.len() as f64;
+            assert!((r.loss_tail - mean).abs() <= 1e-12 * mean.abs(), "{steps} steps: {} against {mean}", r.loss_tail);
+            assert_eq!(r.loss_last, *losses.last().unwrap());
+        }
     }
 
     /// The gate: a sample whose nearest inside→outside direction is farther than

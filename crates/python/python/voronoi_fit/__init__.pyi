@@ -65,6 +65,7 @@ def fit(
     skip_metrics: Optional[bool] = None,
     polish_steps: Optional[int] = None,
     polish_lr: Optional[float] = None,
+    polish_batch: Optional[int] = None,
     polish_align: Optional[float] = None,
 ) -> FitResult: ...
 def save_mesh(
