@@ -44,6 +44,14 @@ fn main_job_runs_on_every_shared_mesh_and_asset() {
         let r = report(&out);
         assert_eq!(r["crust"]["is_closed"], true, "{name}");
         assert_eq!(r["crust"]["is_manifold"], true, "{name}");
+        // The crust stage's parts are within it (the rest is relabelling), and the written
+        // crust and carving took time.
+        let t = &r["timings_seconds"];
+        let part = |k: &str| t["crust_parts"][k].as_f64().unwrap();
+        let parts = ["guard", "carve", "prune", "write"].map(part);
+        assert!(parts.iter().all(|&s| s >= 0.0), "{name}: {t}");
+        assert!(parts.iter().sum::<f64>() <= t["crust"].as_f64().unwrap(), "{name}: {t}");
+        assert!(part("write") > 0.0 && (part("carve") > 0.0 || r["carving"].is_null()), "{name}: {t}");
         let mis = r["quality"]["misclassification"].as_f64().unwrap();
         // Simple closed shapes are fitted well even with these small settings; the others
         // (a genus-1409 sponge, open meshes, a soup whose |winding number| ≥ 0.5 region is

@@ -306,10 +306,12 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
         trainer: &trainer,
         cap_samples: solid_report.cap_samples,
         diagonal,
+        parts: Default::default(),
     };
     let (chosen, measured, polish_choice) = after.polish_and_crust(progress, &mut clock)?;
     let crust_mesh = chosen.checked.written.mesh.clone();
     clock.timings.crust += clock.lap();
+    clock.timings.crust_parts = after.parts.get();
 
     progress.stage(Stage::Evaluate);
     let quality = misclassification(&sampler, target.solid(), &chosen.sites, &chosen.labels, config, diagonal)?;
@@ -418,6 +420,8 @@ struct AfterTraining<'a> {
     /// Surface samples on the winding solid's caps (at the end of `data.surface`).
     cap_samples: usize,
     diagonal: f64,
+    /// Seconds of the crust stage's parts, summed over attempts.
+    parts: std::cell::Cell<crate::report::CrustParts>,
 }
 
 impl AfterTraining<'_> {
@@ -637,10 +641,19 @@ impl AfterTraining<'_> {
             }
             _ => None,
         };
+        let lap = |t: &mut Instant| {
+            let s = t.elapsed().as_secs_f64();
+            *t = Instant::now();
+            s
+        };
+        let mut t = Instant::now();
+        let mut parts = self.parts.get();
         let mut guard = match guard_box {
             Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
             None => None,
         };
+        parts.guard += lap(&mut t);
+        self.parts.set(parts);
         // Carving's mirrors can leave Voronoi features finer than the output's precision holds
         // (on snowden, a thin-walled shell, at K = 8,192: float32 rounding broke the crust
         // beyond repair); then carving runs again from the same sites without them.
@@ -669,6 +682,9 @@ impl AfterTraining<'_> {
                 }
                 None => None,
             };
+            let mut parts = self.parts.get();
+            parts.carve += lap(&mut t);
+            self.parts.set(parts);
             if let Some(r) = carving.as_ref().filter(|r| r.gated) {
                 return Ok(Err(r.first_surface));
             }
@@ -677,14 +693,20 @@ impl AfterTraining<'_> {
                     g.after_carving(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?);
                 }
             }
+            parts.guard += lap(&mut t);
             let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
+            parts.prune += lap(&mut t);
+            self.parts.set(parts);
             let mirrored = carving.as_ref().is_some_and(|r| r.inserted_as_mirrors_per_round.iter().sum::<usize>() > 0);
             // Mapped by the sites file's own matrix, evaluated as `crust::SitesFile` and
             // `voronoi-fit crust` evaluate it, so the crust of the written sites is this crust
             // to the bit (mapping by centre and scale rounds differently, and a merge of
             // vertices a few float steps apart could then go the other way).
             let map = FrameMap::Matrix(self.p.transform.from_unit_matrix());
-            match crust_of(&sites, &labels, map, config.output_precision) {
+            let written = crust_of(&sites, &labels, map, config.output_precision);
+            parts.write += lap(&mut t);
+            self.parts.set(parts);
+            match written {
                 Ok(checked) => return Ok(Ok((sites, labels, guard, carving, pruning, checked))),
                 Err(e) if mirrored && e.is_input_fault() => {
                     let Some((s, l, g)) = before_carving.clone() else { return Err(e) };

@@ -88,6 +88,24 @@ pub struct Timings {
     pub evaluate: f64,
     /// Metrics against the input.
     pub metrics: f64,
+    /// Where the crust stage's time went (summed over both attempts on a closed input; the
+    /// rest of `crust` is relabelling and bookkeeping).
+    pub crust_parts: CrustParts,
+}
+
+/// Parts of the crust stage, seconds ([`Timings::crust_parts`]).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct CrustParts {
+    /// The guard against crust outside the input's box, before and after carving.
+    pub guard: f64,
+    /// Carving: its rounds' crust extractions, their distances to the input and the sites
+    /// they insert.
+    pub carve: f64,
+    /// Pruning sites that change no crust face.
+    pub prune: f64,
+    /// The crust as written: extraction, rounding to the output's precision, the repair
+    /// of what rounding breaks, and the exact checks.
+    pub write: f64,
 }
 
 /// Per-step losses, subsampled to at most about 200 rows.
