@@ -175,22 +175,35 @@ fn choose_alignment(
     }
 }
 
+/// Seconds since the last lap.
+struct Lap(Instant);
+
+impl Lap {
+    fn start() -> Self {
+        Lap(Instant::now())
+    }
+
+    fn lap(&mut self) -> f64 {
+        let s = self.0.elapsed().as_secs_f64();
+        self.0 = Instant::now();
+        s
+    }
+}
+
 /// Stage timer: the time since the last lap, and the report's per-stage timings.
 struct Clock {
-    t: Instant,
+    t: Lap,
     timings: Timings,
 }
 
 impl Clock {
     fn new() -> Self {
-        Clock { t: Instant::now(), timings: Timings::default() }
+        Clock { t: Lap::start(), timings: Timings::default() }
     }
 
     /// Seconds since the last lap.
     fn lap(&mut self) -> f64 {
-        let s = self.t.elapsed().as_secs_f64();
-        self.t = Instant::now();
-        s
+        self.t.lap()
     }
 }
 
@@ -421,7 +434,7 @@ struct AfterTraining<'a> {
     cap_samples: usize,
     diagonal: f64,
     /// Seconds of the crust stage's parts, summed over attempts.
-    parts: std::cell::Cell<crate::report::CrustParts>,
+    parts: std::cell::Cell<CrustParts>,
 }
 
 impl AfterTraining<'_> {
@@ -641,19 +654,18 @@ impl AfterTraining<'_> {
             }
             _ => None,
         };
-        let lap = |t: &mut Instant| {
-            let s = t.elapsed().as_secs_f64();
-            *t = Instant::now();
-            s
+        // The report's `crust_parts`: seconds since the last lap added to one of them.
+        let mut t = Lap::start();
+        let mut add = |part: fn(&mut CrustParts) -> &mut f64| {
+            let mut parts = self.parts.get();
+            *part(&mut parts) += t.lap();
+            self.parts.set(parts);
         };
-        let mut t = Instant::now();
-        let mut parts = self.parts.get();
         let mut guard = match guard_box {
             Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
             None => None,
         };
-        parts.guard += lap(&mut t);
-        self.parts.set(parts);
+        add(|p| &mut p.guard);
         // Carving's mirrors can leave Voronoi features finer than the output's precision holds
         // (on snowden, a thin-walled shell, at K = 8,192: float32 rounding broke the crust
         // beyond repair); then carving runs again from the same sites without them.
@@ -682,9 +694,7 @@ impl AfterTraining<'_> {
                 }
                 None => None,
             };
-            let mut parts = self.parts.get();
-            parts.carve += lap(&mut t);
-            self.parts.set(parts);
+            add(|p| &mut p.carve);
             if let Some(r) = carving.as_ref().filter(|r| r.gated) {
                 return Ok(Err(r.first_surface));
             }
@@ -693,10 +703,9 @@ impl AfterTraining<'_> {
                     g.after_carving(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?);
                 }
             }
-            parts.guard += lap(&mut t);
+            add(|p| &mut p.guard);
             let pruning = if config.prune { Some(prune(&mut sites, &mut labels)?) } else { None };
-            parts.prune += lap(&mut t);
-            self.parts.set(parts);
+            add(|p| &mut p.prune);
             let mirrored = carving.as_ref().is_some_and(|r| r.inserted_as_mirrors_per_round.iter().sum::<usize>() > 0);
             // Mapped by the sites file's own matrix, evaluated as `crust::SitesFile` and
             // `voronoi-fit crust` evaluate it, so the crust of the written sites is this crust
@@ -704,8 +713,7 @@ impl AfterTraining<'_> {
             // vertices a few float steps apart could then go the other way).
             let map = FrameMap::Matrix(self.p.transform.from_unit_matrix());
             let written = crust_of(&sites, &labels, map, config.output_precision);
-            parts.write += lap(&mut t);
-            self.parts.set(parts);
+            add(|p| &mut p.write);
             match written {
                 Ok(checked) => return Ok(Ok((sites, labels, guard, carving, pruning, checked))),
                 Err(e) if mirrored && e.is_input_fault() => {
