@@ -443,10 +443,22 @@ impl AfterTraining<'_> {
     fn measure(&self, crust: &TriMesh) -> MetricsReport {
         let opts = metrics::EvalOptions { skip_validity: true, iou_samples: Some(0), ..Default::default() };
         let seed = opts.surface.seed.wrapping_add(2);
-        let measured = metrics::evaluate(&self.p.mesh, crust, &opts).and_then(|mut m| {
-            m.iou = Some(self.iou_against_the_solid(crust, IOU_SAMPLES, seed)?);
-            Ok(m)
-        });
+        // Interior faces are told apart by the solid fitted, in the unit cube (on a soup the
+        // raw input's winding number is ambiguous beside every single-sided panel and its
+        // exact fallback costs minutes).
+        let t = &self.p.transform;
+        let eps = metrics::BURIED_OFFSET * self.diagonal;
+        let interior = |points: &[[f64; 3]], normals: &[[f64; 3]]| {
+            let unit: Vec<[f64; 3]> = points.iter().map(|&x| t.to_unit(x)).collect();
+            let sign = t.scale.signum();
+            let normals: Vec<[f64; 3]> = normals.iter().map(|n| n.map(|c| sign * c)).collect();
+            Ok(self.target.buried(&unit, &normals, eps))
+        };
+        let measured = metrics::evaluate_with(&self.p.mesh, crust, &opts, (self.target.interior_by(), interior))
+            .and_then(|mut m| {
+                m.iou = Some(self.iou_against_the_solid(crust, IOU_SAMPLES, seed)?);
+                Ok(m)
+            });
         match measured {
             Ok(m) => MetricsReport::Done(Box::new(m)),
             Err(e) => MetricsReport::Failed { error: e.to_string() },

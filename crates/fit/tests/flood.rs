@@ -171,4 +171,12 @@ fn a_volume_filling_soup_takes_the_flood_solid() {
     assert!(f.boundary_share < fit::config::FLOOD_BOUNDARY_SHARE, "{f:?}");
     assert!(f.boundary_share + f.interior_share >= fit::config::FLOOD_ENCLOSED_SHARE, "{f:?}");
     assert!(out.report.crust.is_closed && out.report.crust.is_manifold, "{:?}", out.report.crust);
+    // The report's metrics tell the inner faces apart by the solid fitted (the raw soup's
+    // winding number would take its exact fallback beside every open face): the same
+    // share the flood solid left out of the training pool, on other samples.
+    let fit::report::MetricsReport::Done(m) = &out.report.metrics else { panic!("metrics were asked for") };
+    let b = &m.solid_boundary;
+    assert!(b.interior_by.contains("flood solid"), "{b:?}");
+    let left_out = f.interior_share + f.crevice_share;
+    assert!(left_out > 0.3 && (b.interior_share - left_out).abs() < 0.03, "{b:?} against {f:?}");
 }

@@ -59,6 +59,9 @@ pub fn buried<E>(
 pub struct SolidBoundary {
     /// Reference samples drawn (area-uniform, seeded).
     pub num_samples: usize,
+    /// The solid that told interior samples apart: the reference's own (`voronoi-fit
+    /// eval`) or, in the main job's report, the solid the sites were fitted to.
+    pub interior_by: String,
     /// Share of them with the reference's solid on both sides (interior faces).
     pub interior_share: f64,
     /// Largest distance from a boundary sample to the prediction.
@@ -73,9 +76,13 @@ pub struct SolidBoundary {
     pub hausdorff_estimate: f64,
 }
 
+/// What [`solid_boundary`] calls the reference's own solid.
+pub const OWN_SOLID: &str =
+    "the reference's own solid (signed crossings when closed, |winding number| >= 0.5 otherwise)";
+
 /// Samples `reference`'s surface (`n` points, `seed`), splits the samples into interior and
-/// boundary ones (module doc) and measures their distances to `prediction`;
-/// `prediction_to_reference` is the certified run's witness of that direction.
+/// boundary ones by the reference's own solid (module doc) and measures their distances to
+/// `prediction`; `prediction_to_reference` is the certified run's witness of that direction.
 ///
 /// # Errors
 /// [`MetricsError::BadOption`] for `n == 0`, [`MetricsError::ZeroArea`] for a reference
@@ -87,6 +94,33 @@ pub fn solid_boundary(
     seed: u64,
     prediction_to_reference: f64,
 ) -> Result<SolidBoundary, MetricsError> {
+    let mesh: &TriMesh = reference.mesh();
+    let eps = BURIED_OFFSET * mesh.diagonal();
+    let own = |points: &[[f64; 3]], normals: &[[f64; 3]]| -> Result<Vec<bool>, MetricsError> {
+        let oracle = MeshOracle::from_mesh(mesh, &Config::default())?;
+        Ok(buried(points, normals, eps, |q| oracle.inside(q))?)
+    };
+    solid_boundary_with(reference, prediction, n, seed, prediction_to_reference, (OWN_SOLID, own))
+}
+
+/// [`solid_boundary`] with interior samples told apart by another solid: `interior` is its
+/// name and a function from the samples (reference frame) and their unit normals to
+/// whether each is buried in it (the main job passes the solid it fitted, which on a soup
+/// is cheaper to ask than the raw input's winding number and is what the crust follows).
+///
+/// # Errors
+/// As [`solid_boundary`], and whatever `interior` returns.
+pub fn solid_boundary_with<F>(
+    reference: &DistanceMesh,
+    prediction: &DistanceMesh,
+    n: usize,
+    seed: u64,
+    prediction_to_reference: f64,
+    interior: (&str, F),
+) -> Result<SolidBoundary, MetricsError>
+where
+    F: FnOnce(&[[f64; 3]], &[[f64; 3]]) -> Result<Vec<bool>, MetricsError>,
+{
     if n == 0 {
         return Err(MetricsError::BadOption("the number of boundary samples must be > 0".into()));
     }
@@ -96,8 +130,14 @@ pub fn solid_boundary(
         area: mesh_io::TopologyReport::of(mesh).surface_area,
     })?;
     let s = sampler.sample(n, seed);
-    let oracle = MeshOracle::from_mesh(mesh, &Config::default())?;
-    let is_buried = buried(&s.points, &s.normals, BURIED_OFFSET * mesh.diagonal(), |q| oracle.inside(q))?;
+    let (interior_by, is_buried) = interior;
+    let is_buried = is_buried(&s.points, &s.normals)?;
+    if is_buried.len() != n {
+        return Err(MetricsError::BadOption(format!(
+            "the interior test gave {} answers for {n} samples",
+            is_buried.len()
+        )));
+    }
     let mut dist = vec![0.0; n];
     dist.par_chunks_mut(1024).enumerate().for_each(|(c, o)| {
         let mut ws = Workspace::new();
@@ -117,6 +157,7 @@ pub fn solid_boundary(
     }
     Ok(SolidBoundary {
         num_samples: n,
+        interior_by: interior_by.to_string(),
         interior_share: interior as f64 / n as f64,
         max_boundary_to_prediction: max_b,
         max_interior_to_prediction: max_i,

@@ -5,7 +5,7 @@ use std::time::Instant;
 use mesh_io::TriMesh;
 use serde::Serialize;
 
-use crate::boundary::{solid_boundary, SolidBoundary};
+use crate::boundary::{solid_boundary, solid_boundary_with, SolidBoundary};
 use crate::hausdorff::{certify, CertifiedOptions, DistanceMesh, HausdorffInterval, Sides};
 use crate::iou::{volumetric_iou, IouResult};
 use crate::surface::{surface_metrics_of, SurfaceMetrics, SurfaceOptions};
@@ -58,6 +58,36 @@ pub struct EvalReport {
 /// [`MetricsError`] for an empty, non-finite or out-of-range mesh (named "reference" or
 /// "prediction"), a mesh without area, or an invalid option.
 pub fn evaluate(reference: &TriMesh, prediction: &TriMesh, opts: &EvalOptions) -> Result<EvalReport, MetricsError> {
+    evaluate_inner(reference, prediction, opts, None::<(&str, fn(&[[f64; 3]], &[[f64; 3]]) -> _)>)
+}
+
+/// [`evaluate`] with the reference's interior faces told apart by another solid
+/// ([`solid_boundary_with`]'s `interior`: a name, and whether each surface sample with its
+/// unit normal is buried in it).
+///
+/// # Errors
+/// As [`evaluate`], and whatever `interior` returns.
+pub fn evaluate_with<F>(
+    reference: &TriMesh,
+    prediction: &TriMesh,
+    opts: &EvalOptions,
+    interior: (&str, F),
+) -> Result<EvalReport, MetricsError>
+where
+    F: FnOnce(&[[f64; 3]], &[[f64; 3]]) -> Result<Vec<bool>, MetricsError>,
+{
+    evaluate_inner(reference, prediction, opts, Some(interior))
+}
+
+fn evaluate_inner<F>(
+    reference: &TriMesh,
+    prediction: &TriMesh,
+    opts: &EvalOptions,
+    interior: Option<(&str, F)>,
+) -> Result<EvalReport, MetricsError>
+where
+    F: FnOnce(&[[f64; 3]], &[[f64; 3]]) -> Result<Vec<bool>, MetricsError>,
+{
     let t0 = Instant::now();
     let (r, p) =
         rayon::join(|| DistanceMesh::new(reference, "reference"), || DistanceMesh::new(prediction, "prediction"));
@@ -75,13 +105,12 @@ pub fn evaluate(reference: &TriMesh, prediction: &TriMesh, opts: &EvalOptions) -
     } else {
         None
     };
-    let boundary = solid_boundary(
-        &r,
-        &p,
-        opts.surface.num_samples,
-        opts.surface.seed.wrapping_add(3),
-        hausdorff.directed_witness[1],
-    )?;
+    let (n, seed, witness) =
+        (opts.surface.num_samples, opts.surface.seed.wrapping_add(3), hausdorff.directed_witness[1]);
+    let boundary = match interior {
+        Some(interior) => solid_boundary_with(&r, &p, n, seed, witness, interior)?,
+        None => solid_boundary(&r, &p, n, seed, witness)?,
+    };
     let prediction_validity = (!opts.skip_validity).then(|| validity(prediction));
     Ok(EvalReport {
         format_version: 1,

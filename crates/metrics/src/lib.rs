@@ -36,9 +36,9 @@ pub mod iou;
 pub mod surface;
 pub mod validity;
 
-pub use boundary::{buried, solid_boundary, SolidBoundary, BURIED_OFFSET};
+pub use boundary::{buried, solid_boundary, solid_boundary_with, SolidBoundary, BURIED_OFFSET, OWN_SOLID};
 pub use error::MetricsError;
-pub use eval::{evaluate, EvalOptions, EvalReport};
+pub use eval::{evaluate, evaluate_with, EvalOptions, EvalReport};
 pub use hausdorff::{
     check_mesh, directed_hausdorff_certified, hausdorff_certified, hausdorff_libigl, hausdorff_sphere_certified,
     hausdorff_sphere_certified_limited, CertifiedOptions, DistanceMesh, HausdorffInterval, SphereInterval,

@@ -73,6 +73,46 @@ impl Target<'_> {
         }
     }
 
+    /// Whether each surface point (unit cube, with the unit normal of its face) lies on a
+    /// face the solid buries — the solid on both of its sides — for the report's
+    /// `solid_boundary`: for the winding solid, inside at ±`eps` along the normal (as
+    /// `voronoi-fit eval` asks the input's own solid); for the flood solid, enclosed on both
+    /// sides or in a crevice (the surface the fit leaves out; a sheet has the outside on both
+    /// sides and is not buried, though its band holds both probes); the shell buries
+    /// nothing. A point without a normal is not buried.
+    pub(crate) fn buried(&self, points: &[[f64; 3]], normals: &[[f64; 3]], eps: f64) -> Vec<bool> {
+        use rayon::prelude::*;
+        match self {
+            Target::Winding(s) => {
+                let Ok(b) = metrics::buried(points, normals, eps, |q| Ok::<_, std::convert::Infallible>(s.inside(q)));
+                b.into_iter().zip(normals).map(|(b, n)| b && *n != [0.0; 3]).collect()
+            }
+            Target::Flood(s) => points
+                .par_iter()
+                .zip(normals)
+                .map(|(&x, &n)| {
+                    n != [0.0; 3]
+                        && matches!(
+                            s.surface_side(x, n),
+                            soft_voronoi::SurfaceSide::Interior | soft_voronoi::SurfaceSide::Crevice
+                        )
+                })
+                .collect(),
+            Target::Shell(..) => vec![false; points.len()],
+        }
+    }
+
+    /// What told the report's `solid_boundary` interior faces apart.
+    pub(crate) fn interior_by(&self) -> &'static str {
+        match self {
+            Target::Winding(_) => {
+                "the solid fitted: the winding-number solid of the input, its pieces consistently oriented"
+            }
+            Target::Flood(_) => "the solid fitted: the flood solid (faces enclosed on both sides and crevices)",
+            Target::Shell(..) => "the solid fitted: the thin shell (no face is buried in it)",
+        }
+    }
+
     /// Whether the target places its own sites (then they are not trained by default).
     pub(crate) fn places_sites(&self) -> bool {
         matches!(self, Target::Shell(..))
