@@ -107,6 +107,119 @@ pub fn guard(
     Ok(report)
 }
 
+/// Rounds of [`guard_solid`] at most.
+pub const SOLID_GUARD_ROUNDS: usize = 6;
+
+/// The same cut as [`guard`]'s across the solid's own surface: for each crust vertex v
+/// outside `solid` and farther than `threshold` from it (an inside cell running out into
+/// empty space, where training left too few outside sites: the fins of a soup's thin wings),
+/// c its closest point on the solid's surface and n = (v − c)/|v − c|, each inside site s
+/// nearest to v (its cell's owner) that lies behind the tangent plane P through c (depth
+/// d = (c − s)·n > 0) gets the outside site m = s + (2 + j)·d·n, j ∈ [0, 0.01) a fixed
+/// jitter per site. The bisector of s and m is P moved out by j·d/2, so nothing behind it
+/// changes (as for the box: a point there is nearer s than m, and its nearest site at
+/// least as near as s), and s's cell stops there. The jitter keeps two mirrors across one
+/// plane from making four cospherical sites, whose Voronoi vertex float32 rounding can
+/// break. A mirror is added only where it is outside the solid and at least d/2 from it
+/// (its cell cannot reach the solid beyond the plane), within the unit cube and new. Up to
+/// `rounds` rounds, as for the box. Returns the sites added per round and the farthest
+/// crust vertex outside the solid before the first round and after the last, unit-cube
+/// lengths.
+///
+/// # Errors
+/// [`FitError::Crust`] when a crust cannot be extracted.
+pub fn guard_solid(
+    sites: &mut Vec<[f64; 3]>,
+    labels: &mut Vec<bool>,
+    solid: &dyn soft_voronoi::Solid,
+    threshold: f64,
+    rounds: usize,
+) -> Result<(Vec<usize>, f64, f64), FitError> {
+    let (mut added_per_round, mut before, mut after) = (Vec::new(), 0.0, 0.0);
+    let mut existing: std::collections::HashSet<[u64; 3]> = sites.iter().map(|p| p.map(f64::to_bits)).collect();
+    let d2 = |a: [f64; 3], b: [f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>();
+    for round in 0..=rounds {
+        let crust = Crust::extract(sites, labels, &CrustConfig::default())
+            .map_err(|source| FitError::Crust { during: "guarding the solid", source })?;
+        let located = solid.locate(&crust.mesh.positions);
+        let outside = crust.mesh.positions.iter().zip(&located).filter(|(_, l)| !l.inside);
+        let reach = outside.clone().fold(0.0f64, |m, (v, l)| m.max(d2(*v, l.closest)));
+        if round == 0 {
+            before = reach.sqrt();
+        }
+        after = reach.sqrt();
+        let far: Vec<([f64; 3], [f64; 3])> =
+            outside.filter(|(v, l)| d2(**v, l.closest) > threshold * threshold).map(|(v, l)| (*v, l.closest)).collect();
+        if far.is_empty() || round == rounds {
+            break;
+        }
+        let inside: Vec<[f64; 3]> = sites.iter().zip(labels.iter()).filter(|(_, &l)| l).map(|(p, _)| *p).collect();
+        if inside.is_empty() {
+            break;
+        }
+        let tree = soft_voronoi::knn::KnnTree::new(&inside);
+        let mut near = Vec::new();
+        let mut mirrors: Vec<([f64; 3], f64)> = Vec::new();
+        for (v, c) in far {
+            let len = d2(v, c).sqrt();
+            let n = [0, 1, 2].map(|k| (v[k] - c[k]) / len);
+            // The inside sites nearest to v: its cell's owners (see `guard`).
+            tree.k_nearest(v, 8, &mut near);
+            let nearest = near.first().map_or(f64::INFINITY, |n| n.0);
+            for nb in near.iter().filter(|nb| nb.0 <= nearest * (1.0 + 1e-9) + 1e-30) {
+                let s = inside[nb.1 as usize];
+                let depth: f64 = (0..3).map(|k| (c[k] - s[k]) * n[k]).sum();
+                if depth <= 0.0 {
+                    continue;
+                }
+                let offset = (2.0 * depth).max(threshold) * (1.0 + jitter(s));
+                let m = [0, 1, 2].map(|k| s[k] + offset * n[k]);
+                if m.iter().all(|&x| x > 0.0 && x < 1.0) {
+                    mirrors.push((m, offset));
+                }
+            }
+        }
+        let points: Vec<[f64; 3]> = mirrors.iter().map(|m| m.0).collect();
+        let mut added = 0;
+        // Not near a site already there (nor one added this round): two sites much nearer
+        // each other than their neighbours make Voronoi features finer than float32 holds.
+        let all = soft_voronoi::knn::KnnTree::new(sites);
+        let mut new: Vec<[f64; 3]> = Vec::new();
+        for ((m, offset), l) in mirrors.into_iter().zip(solid.locate(&points)) {
+            let min2 = 0.0625 * offset * offset;
+            if l.inside || d2(m, l.closest) < min2 {
+                continue;
+            }
+            all.k_nearest(m, 1, &mut near);
+            if near.first().is_some_and(|n| n.0 < min2) || new.iter().any(|&q| d2(q, m) < min2) {
+                continue;
+            }
+            if existing.insert(m.map(f64::to_bits)) {
+                new.push(m);
+                added += 1;
+            }
+        }
+        for m in new {
+            sites.push(m);
+            labels.push(false);
+        }
+        added_per_round.push(added);
+        if added == 0 {
+            break;
+        }
+    }
+    Ok((added_per_round, before, after))
+}
+
+/// A fixed number in [0, 0.01) for a site, from its coordinates' bits (splitmix64).
+fn jitter(s: [f64; 3]) -> f64 {
+    let mut z = s.iter().fold(0x9E37_79B9_7F4A_7C15u64, |h, x| h.rotate_left(21) ^ x.to_bits());
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    0.01 * (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -160,5 +273,70 @@ mod tests {
         // A second call finds nothing to do.
         let again = guard(&mut sites, &mut labels, lo, hi, 1e-3).unwrap();
         assert!(again.inserted_per_round.is_empty(), "{again:?}");
+    }
+
+    /// The label of the nearest site at each point (ties to the lower index).
+    fn labels_at(sites: &[[f64; 3]], labels: &[bool], points: &[[f64; 3]]) -> Vec<bool> {
+        let tree = soft_voronoi::knn::KnnTree::new(sites);
+        let mut near = Vec::new();
+        points
+            .iter()
+            .map(|&p| {
+                tree.k_nearest(p, 1, &mut near);
+                labels[near[0].1 as usize]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_cell_running_out_of_the_solid_is_cut_at_its_tangent_plane_and_the_solid_keeps_its_labels() {
+        // A ball of radius 0.2: inside sites on a sphere of radius 0.15 and at the centre,
+        // outside sites on one of radius 0.27 except in a cone around +x, where the inside
+        // cells run out to the cube's corner sites. The solid guard must cut them back near
+        // the ball without changing the label of any point in the ball (every mirror's
+        // bisector lies beyond a tangent plane).
+        let ball = soft_voronoi::solid::Sphere { center: [0.5; 3], radius: 0.2 };
+        let fib = |n: usize, r: f64| -> Vec<[f64; 3]> {
+            (0..n)
+                .map(|i| {
+                    let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                    let (rho, phi) = ((1.0 - z * z).sqrt(), i as f64 * 2.399_963_229_728_653);
+                    [0.5 + r * z, 0.5 + r * rho * phi.cos(), 0.5 + r * rho * phi.sin()]
+                })
+                .collect()
+        };
+        let mut sites = vec![[0.5; 3]];
+        let mut labels = vec![true];
+        for p in fib(200, 0.15) {
+            sites.push(p);
+            labels.push(true);
+        }
+        for p in fib(300, 0.27).into_iter().filter(|p| p[0] < 0.5 + 0.27 * 0.6) {
+            sites.push(p);
+            labels.push(false);
+        }
+        for corner in 0..8 {
+            sites.push([0, 1, 2].map(|k| if corner >> k & 1 == 1 { 0.98 } else { 0.02 }));
+            labels.push(false);
+        }
+        let threshold = 0.01;
+        let beyond = |sites: &[[f64; 3]], labels: &[bool]| {
+            let crust = Crust::extract(sites, labels, &CrustConfig::default()).unwrap();
+            crust.mesh.positions.iter().fold(0.0f64, |m, &v| m.max(ball.center_distance(v) - ball.radius))
+        };
+        let before = beyond(&sites, &labels);
+        assert!(before > 0.1, "the setup must run out of the ball: {before}");
+        // Probes in the ball, on a grid.
+        let probes: Vec<[f64; 3]> = (0..20 * 20 * 20)
+            .map(|i| [i % 20, i / 20 % 20, i / 400].map(|c| 0.3 + 0.4 * (c as f64 + 0.5) / 20.0))
+            .filter(|&p| ball.center_distance(p) < ball.radius)
+            .collect();
+        let inside_before = labels_at(&sites, &labels, &probes);
+        let n = sites.len();
+        let (per_round, from, to) = guard_solid(&mut sites, &mut labels, &ball, threshold, SOLID_GUARD_ROUNDS).unwrap();
+        assert!(per_round[0] > 0 && sites.len() > n && labels[n..].iter().all(|&l| !l), "{per_round:?}");
+        assert!((from - before).abs() < 1e-12, "{from} against {before}");
+        assert!(to < 0.5 * before && (to - beyond(&sites, &labels)).abs() < 1e-12, "{before} -> {to}");
+        assert_eq!(labels_at(&sites, &labels, &probes), inside_before, "a point of the ball changed its label");
     }
 }

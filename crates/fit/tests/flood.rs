@@ -95,6 +95,11 @@ fn the_flood_solid_keeps_every_part_of_a_soup() {
     assert!(out.report.summary().lines().all(|l| l.chars().count() <= 100), "{}", out.report.summary());
     let c = &out.report.crust;
     assert!(c.is_closed && c.is_manifold, "{c:?}");
+    // The solid guard ran on the flood solid, and where it added mirrors the crust stands
+    // no farther outside the solid than before.
+    let g = out.report.guard.as_ref().expect("carving is on, so is the guard");
+    assert!(g.solid_beyond_before > 0.0 && g.solid_mirrors_dropped.is_none(), "{g:?}");
+    assert!(g.solid_beyond_after <= g.solid_beyond_before, "{g:?}");
     let h = f.sheet_half_thickness_of_diagonal;
     let d = distances(&out.crust, &probes);
     for ((name, _), d) in probes.iter().zip(&d) {

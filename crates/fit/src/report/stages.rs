@@ -243,6 +243,18 @@ pub struct GuardReport {
     pub beyond_before: f64,
     /// After the last round.
     pub beyond_after: f64,
+    /// Flood solid only: outside sites added per round by `guard::guard_solid`, mirrors of
+    /// inside sites across the solid's tangent planes where the crust stood outside it
+    /// farther than `threshold` (empty for other solids).
+    pub solid_mirrors_per_round: Vec<usize>,
+    /// How far the crust stood outside the solid before and after those rounds, unit-cube
+    /// lengths (0 when they did not run).
+    pub solid_beyond_before: f64,
+    /// After the last round.
+    pub solid_beyond_after: f64,
+    /// Why the solid's mirrors were taken back (the crust with them could not be written
+    /// at the output's precision), or `None`.
+    pub solid_mirrors_dropped: Option<String>,
 }
 
 impl GuardReport {

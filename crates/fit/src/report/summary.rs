@@ -255,9 +255,32 @@ impl FitReport {
         }
     }
 
-    /// What the bounding-box guard added, when it added anything.
+    /// What the bounding-box guard and the solid guard added, when they added anything.
     fn guard_sentence(&self) -> String {
-        match &self.guard {
+        let solid = match &self.guard {
+            Some(g) if g.solid_mirrors_dropped.is_some() => {
+                " The solid guard's mirrors were taken back: the crust with them did not survive rounding to the \
+                 output's precision."
+                    .to_string()
+            }
+            Some(g) if g.solid_mirrors_per_round.iter().sum::<usize>() > 0 => {
+                let of_diag = self
+                    .carving
+                    .as_ref()
+                    .filter(|r| r.tolerance > 0.0)
+                    .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
+                format!(
+                    " {} outside sites were added as mirror images of inside sites across the solid's tangent planes, \
+                     where their cells ran out of the solid (the crust stood {:.3}% of the diagonal outside it, then \
+                     {:.3}%).",
+                    g.solid_mirrors_per_round.iter().sum::<usize>(),
+                    100.0 * g.solid_beyond_before * of_diag,
+                    100.0 * g.solid_beyond_after * of_diag,
+                )
+            }
+            _ => String::new(),
+        };
+        let boxed = match &self.guard {
             Some(g) if g.inserted() > 0 => {
                 // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
                 let of_diag = self
@@ -280,7 +303,8 @@ impl FitReport {
                 )
             }
             _ => String::new(),
-        }
+        };
+        format!("{solid}{boxed}")
     }
 
     /// The polish and, on a closed input, the choice of the aligned one.
