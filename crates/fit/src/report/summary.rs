@@ -257,6 +257,12 @@ impl FitReport {
 
     /// What the bounding-box guard and the solid guard added, when they added anything.
     fn guard_sentence(&self) -> String {
+        // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
+        let of_diag = self
+            .carving
+            .as_ref()
+            .filter(|r| r.tolerance > 0.0)
+            .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
         let solid = match &self.guard {
             Some(g) if g.solid_mirrors_dropped.is_some() => {
                 " The solid guard's mirrors were taken back: the crust with them did not survive rounding to the \
@@ -264,11 +270,6 @@ impl FitReport {
                     .to_string()
             }
             Some(g) if g.solid_mirrors_per_round.iter().sum::<usize>() > 0 => {
-                let of_diag = self
-                    .carving
-                    .as_ref()
-                    .filter(|r| r.tolerance > 0.0)
-                    .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
                 format!(
                     " {} outside sites were added as mirror images of inside sites across the solid's tangent planes, \
                      where their cells ran out of the solid (the crust stood {:.3}% of the diagonal outside it, then \
@@ -282,12 +283,6 @@ impl FitReport {
         };
         let boxed = match &self.guard {
             Some(g) if g.inserted() > 0 => {
-                // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
-                let of_diag = self
-                    .carving
-                    .as_ref()
-                    .filter(|r| r.tolerance > 0.0)
-                    .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
                 format!(
                     " {} outside sites were added as mirror images of inside sites across the input's bounding box, \
                      where their cells ran past it (the crust reached {:.3}% of the diagonal beyond the box, now \
