@@ -72,13 +72,7 @@ pub fn guard(
         let mut near = Vec::new();
         let mut added = 0;
         for v in far {
-            // The inside sites nearest to v: the inside sites of its tetrahedron (at most
-            // four unless the sites are cospherical; eight are asked for).
-            tree.k_nearest(v, 8, &mut near);
-            let nearest = near.first().map_or(f64::INFINITY, |n| n.0);
-            let owners: Vec<[f64; 3]> =
-                near.iter().filter(|n| n.0 <= nearest * (1.0 + 1e-9) + 1e-30).map(|n| inside[n.1 as usize]).collect();
-            for s in &owners {
+            for s in &owners(&tree, &inside, v, &mut near) {
                 for k in 0..3 {
                     for (plane, out) in [(lo[k], v[k] < lo[k]), (hi[k], v[k] > hi[k])] {
                         if !out {
@@ -163,11 +157,7 @@ pub fn guard_solid(
         for (v, c) in far {
             let len = d2(v, c).sqrt();
             let n = [0, 1, 2].map(|k| (v[k] - c[k]) / len);
-            // The inside sites nearest to v: its cell's owners (see `guard`).
-            tree.k_nearest(v, 8, &mut near);
-            let nearest = near.first().map_or(f64::INFINITY, |n| n.0);
-            for nb in near.iter().filter(|nb| nb.0 <= nearest * (1.0 + 1e-9) + 1e-30) {
-                let s = inside[nb.1 as usize];
+            for s in owners(&tree, &inside, v, &mut near) {
                 let depth: f64 = (0..3).map(|k| (c[k] - s[k]) * n[k]).sum();
                 if depth <= 0.0 {
                     continue;
@@ -209,6 +199,20 @@ pub fn guard_solid(
         }
     }
     Ok((added_per_round, before, after))
+}
+
+/// The inside sites nearest to the crust vertex `v`, the owners of the cells that meet
+/// there: the inside sites of its tetrahedron (at most four unless the sites are
+/// cospherical; eight are asked for). `near` is scratch space.
+fn owners(
+    tree: &soft_voronoi::knn::KnnTree,
+    inside: &[[f64; 3]],
+    v: [f64; 3],
+    near: &mut Vec<(f64, u32)>,
+) -> Vec<[f64; 3]> {
+    tree.k_nearest(v, 8, near);
+    let nearest = near.first().map_or(f64::INFINITY, |n| n.0);
+    near.iter().filter(|n| n.0 <= nearest * (1.0 + 1e-9) + 1e-30).map(|n| inside[n.1 as usize]).collect()
 }
 
 /// A fixed number in [0, 0.01) for a site, from its coordinates' bits (splitmix64).

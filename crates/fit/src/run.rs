@@ -679,8 +679,9 @@ impl AfterTraining<'_> {
         };
         // On the flood solid, the same cut across the solid's own surface where the crust
         // stands outside it (`guard::guard_solid`: the ModelNet airplane's wing fins, 6.5% of
-        // the diagonal off the input). Not yet on the other solids: measured on soups only.
-        let before_solid_guard = match (guard.as_mut(), guard_box, self.target) {
+        // the diagonal off the input). Not on the winding solid: measured there, it changed
+        // nothing beyond noise but menger, which it made worse (docs/main-job.md).
+        let mut before_solid_guard = match (guard.as_mut(), guard_box, self.target) {
             (Some(g), Some((_, _, threshold)), crate::target::Target::Flood(solid)) => {
                 let before = (sites.clone(), labels.clone(), Some(g.clone()));
                 let (per_round, from, to) = crate::guard::guard_solid(
@@ -701,7 +702,6 @@ impl AfterTraining<'_> {
         // (on snowden, a thin-walled shell, at K = 8,192: float32 rounding broke the crust
         // beyond repair); then carving runs again from the same sites without them, and
         // should that fail too, without the solid guard's mirrors.
-        let mut before_solid_guard = before_solid_guard;
         let mut before_carving = carve.map(|_| (sites.clone(), labels.clone(), guard.clone()));
         let mut mirrors = true;
         let mut dropped = None;
