@@ -359,6 +359,55 @@ fn a_solid_too_thin_for_any_site_falls_back_to_a_thin_shell() {
     assert!(!forced.exists() && !forced.with_extension("report.json").exists());
 }
 
+/// libigl's halftunnel (benches/real_world): a curved sheet with two large openings whose
+/// rims are not planar. Its winding-number solid would be closed by |w| = 0.5 caps of
+/// about 40% of its area, filling the basin; auto takes it as a thin-walled part (a thin
+/// shell), says why, and its crust lies nearer the input than the capped solid's. A scan
+/// whose hole is small beside its surface (the camel's head, open at the neck) keeps its
+/// cap.
+#[test]
+fn an_open_part_whose_caps_would_be_large_is_taken_as_a_shell() {
+    let dir = tempfile::tempdir().unwrap();
+    let hausdorff = |r: &serde_json::Value| {
+        r["metrics"]["hausdorff"]["hi"].as_f64().unwrap() / r["metrics"]["reference_diagonal"].as_f64().unwrap()
+    };
+    let mesh = root().join("benches/real_world/meshes/halftunnel.off");
+    let out = dir.path().join("halftunnel.glb");
+    let o = fit(&mesh, &out, &QUICK);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let shell = report(&out);
+    let s = &shell["solid"];
+    assert_eq!(s["rule"], "shell", "{s}");
+    assert_eq!(s["chosen_by"], fit::CHOSEN_FOR_LARGE_CAPS, "{s}");
+    let share = s["cap_area_share"].as_f64().unwrap();
+    assert!(share >= fit::config::CAPS_SHELL_ABOVE, "caps {share}");
+    assert_eq!(shell["crust"]["is_closed"], true);
+    keep_for_validator(&out, "halftunnel_shell");
+
+    let forced = dir.path().join("forced.glb");
+    let o = fit(&mesh, &forced, &[&QUICK[..], &["--solid", "winding"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let capped = report(&forced);
+    assert_eq!(capped["solid"]["rule"], "winding");
+    assert_eq!(capped["solid"]["chosen_by"], "--solid");
+    assert!((capped["solid"]["cap_area_share"].as_f64().unwrap() - share).abs() < 1e-12);
+    assert!(
+        hausdorff(&shell) < 0.5 * hausdorff(&capped),
+        "shell {:.3}%, capped {:.3}% of the diagonal",
+        100.0 * hausdorff(&shell),
+        100.0 * hausdorff(&capped)
+    );
+
+    let mesh = root().join("benches/real_world/meshes/camelhead_scan.off");
+    let out = dir.path().join("camelhead.glb");
+    let o = fit(&mesh, &out, &QUICK);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s = &report(&out)["solid"];
+    assert_eq!((&s["rule"], &s["chosen_by"]), (&"winding".into(), &"auto".into()), "{s}");
+    let share = s["cap_area_share"].as_f64().unwrap();
+    assert!(share > 0.0 && share < fit::config::CAPS_SHELL_ABOVE, "caps {share}");
+}
+
 /// A unit cube without its bottom face (benches/real_world's `open_box`): the bottom's rim
 /// is planar, so the hole is closed flat before the solid is built and the crust is the
 /// whole cube, within 0.5% of the diagonal of the closed cube; the report and the summary

@@ -46,5 +46,5 @@ pub use grow::{fit_to_accuracy, AccuracyGoal};
 pub use options::FitOptions;
 pub use progress::{NoProgress, Progress, Stage};
 pub use report::FitReport;
-pub use report::CHOSEN_AFTER_EMPTY_WINDING;
+pub use report::{CHOSEN_AFTER_EMPTY_WINDING, CHOSEN_FOR_LARGE_CAPS};
 pub use run::{fit, FitOutput};

@@ -193,8 +193,10 @@ fn a_shell_with_fewer_sites_than_a_rim_quadruplet_still_fits() {
 
 /// An open pipe is an open mesh around a volume for the automatic rule (its winding number
 /// is 0.7–1 inside), so it keeps the winding solid: its planar ends are closed flat (a can
-/// with lids), or, with the fills off, by caps; either way the crust over the ends lies far
-/// from the pipe: the summary says so and names `--solid shell`, which fits the pipe's wall.
+/// with lids). With the fills off, the ends' caps would be half its area, so auto takes a
+/// thin shell; asked for the winding solid, it gets the caps. Either way a capped crust
+/// lies far from the pipe over the ends: the summary says so and names `--solid shell`,
+/// which fits the pipe's wall.
 #[test]
 fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
     let (nu, nv) = (48u32, 12u32);
@@ -221,8 +223,17 @@ fn an_open_pipe_fitted_as_a_volume_points_to_the_shell() {
     assert_eq!(lids.report.solid.cap_samples, 0);
     let summary = lids.report.details();
     assert!(summary.contains("--solid shell fits a thin shell"), "{summary}");
+    // Without the fills, the ends' caps would be half the wall's area: auto takes the
+    // pipe as a thin-walled part.
     let mut open = small("pipe");
     open.sampling.fill_holes = false;
+    let out = fit::fit(&pipe, &open, &mut NoProgress).unwrap();
+    assert_eq!(out.report.solid.rule, SolidRule::Shell);
+    assert_eq!(out.report.solid.chosen_by, fit::CHOSEN_FOR_LARGE_CAPS);
+    let share = out.report.solid.cap_area_share.unwrap();
+    assert!((0.35..0.65).contains(&share), "caps {share} of the wall's area (2π of 4π)");
+    assert!(out.report.summary().contains("caps would add"), "{}", out.report.summary());
+    open.sampling.solid = SolidRule::Winding;
     let out = fit::fit(&pipe, &open, &mut NoProgress).unwrap();
     assert_eq!(out.report.solid.rule, SolidRule::Winding);
     assert!(out.report.solid.holes_filled.is_none());

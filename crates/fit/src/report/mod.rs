@@ -10,7 +10,7 @@ mod summary;
 
 pub use stages::{
     AccuracyReport, BandTrial, CarveReport, FloodReport, GrowthRow, GuardReport, SheetBand, SolidReport, SurfaceBar,
-    CHOSEN_AFTER_EMPTY_WINDING,
+    CHOSEN_AFTER_EMPTY_WINDING, CHOSEN_FOR_LARGE_CAPS,
 };
 pub use summary::{SHELL_HINT_ABOVE, SUMMARY_LINES};
 

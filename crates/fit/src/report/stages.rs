@@ -40,6 +40,11 @@ pub struct SolidReport {
     /// initialisation puts site pairs and the polish pulls bisectors there too (winding
     /// solid of an open mesh only).
     pub cap_samples: usize,
+    /// The caps' estimated area as a share of the input's (winding solid of an open mesh,
+    /// and the shell auto took instead of it; `target::cap_points`): at
+    /// [`crate::config::CAPS_SHELL_ABOVE`] or more, `--solid auto` takes the thin shell.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cap_area_share: Option<f64>,
     /// The thinner bands tried before settling on the shell's half-thickness (shell with
     /// the default thickness and sites kept as constructed only; see `target::thinnest_band`).
     pub thickness_search: Option<Vec<BandTrial>>,
@@ -156,6 +161,10 @@ pub struct BandTrial {
 /// `solid.chosen_by` of a thin shell fitted because the winding-number solid left no site
 /// inside (`fit::fit`'s fallback under `--solid auto`).
 pub const CHOSEN_AFTER_EMPTY_WINDING: &str = "auto: the winding-number solid left no site inside";
+
+/// [`SolidReport::chosen_by`] when `--solid auto` took the shell because the winding solid's
+/// caps would be [`crate::config::CAPS_SHELL_ABOVE`] of the input's area or more.
+pub const CHOSEN_FOR_LARGE_CAPS: &str = "auto: the winding-number solid's caps would be a large part of it";
 
 /// What `carve::carve` did (report field `carving`).
 #[derive(Clone, Debug, Default, Serialize)]

@@ -127,7 +127,17 @@ impl FitReport {
         let by = match s.chosen_by {
             "auto" => "chosen automatically",
             super::CHOSEN_AFTER_EMPTY_WINDING => "chosen automatically: the winding solid left no site inside",
+            super::CHOSEN_FOR_LARGE_CAPS => "",
             _ => "asked for",
+        };
+        let by = if s.chosen_by == super::CHOSEN_FOR_LARGE_CAPS {
+            format!(
+                "chosen automatically: the holes' |w| = 0.5 caps would add {:.0}% to its area, so it is taken as a \
+                 thin-walled part",
+                100.0 * s.cap_area_share.unwrap_or(f64::NAN)
+            )
+        } else {
+            by.to_owned()
         };
         if let (SolidRule::Flood, Some(f)) = (s.rule, &s.flood) {
             return format!(

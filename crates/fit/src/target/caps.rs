@@ -44,13 +44,62 @@ pub fn cap_samples(
     area_per_sample: f64,
     seed: u64,
 ) -> Result<CapSamples, FitError> {
+    Ok(cap_points(oracle, uniform, spacing, radius)?.samples(area_per_sample, seed))
+}
+
+/// The points Newton put on the caps ([`cap_samples`]' first part), their unit normals
+/// and the caps' estimated area, unit frame.
+#[derive(Clone, Debug, Default)]
+pub struct CapPoints {
+    kept: Vec<[f64; 3]>,
+    normals: Vec<[f64; 3]>,
+    area: f64,
+}
+
+impl CapPoints {
+    /// The caps' estimated area (unit-cube lengths squared): the Newton points' slab
+    /// estimate, less the share of the points dropped after the thinning.
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// The points with their tangent disks at `area_per_sample` ([`cap_samples`]).
+    fn samples(self, area_per_sample: f64, seed: u64) -> CapSamples {
+        let CapPoints { kept, normals, area } = self;
+        let base = kept.len();
+        if base == 0 || area_per_sample.is_nan() || area_per_sample <= 0.0 {
+            return (kept, normals, base);
+        }
+        let share = area / kept.len() as f64;
+        let extra = ((share / area_per_sample).round() as usize).clamp(1, CAP_MAX_PER_POINT) - 1;
+        let disk = (share / std::f64::consts::PI).sqrt();
+        let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 7);
+        let (mut points, mut frames) = (kept.clone(), normals.clone());
+        for (p, n) in kept.iter().zip(&normals) {
+            let (u, v) = tangents(*n);
+            for _ in 0..extra {
+                let (rho, phi) = (disk * rng.uniform().sqrt(), std::f64::consts::TAU * rng.uniform());
+                let (a, b) = (rho * phi.cos(), rho * phi.sin());
+                points.push([0, 1, 2].map(|c| (p[c] + a * u[c] + b * v[c]).clamp(0.0, 1.0)));
+                frames.push(*n);
+            }
+        }
+        (points, frames, base)
+    }
+}
+
+/// [`cap_samples`] up to the disks: the Newton points and the caps' area.
+///
+/// # Errors
+/// [`FitError::Occupancy`] when an oracle query fails.
+pub fn cap_points(oracle: &MeshOracle, uniform: &[[f64; 3]], spacing: f64, radius: f64) -> Result<CapPoints, FitError> {
     let fail = |source| FitError::Occupancy { during: "cap samples", source };
     let fast = occupancy::WindingMode::Fast;
     let w = oracle.winding_numbers(uniform, fast).map_err(fail)?;
     let band: Vec<[f64; 3]> =
         uniform.iter().zip(&w).filter(|(_, w)| (w.abs() - 0.5).abs() < CAP_BAND).map(|(p, _)| *p).collect();
     if band.is_empty() {
-        return Ok((Vec::new(), Vec::new(), 0));
+        return Ok(CapPoints::default());
     }
     let clearance2 = (CAP_CLEARANCE * spacing).powi(2);
     let far = |points: &[[f64; 3]]| -> Result<Vec<bool>, FitError> {
@@ -113,7 +162,7 @@ pub fn cap_samples(
         points = step(&points)?.into_iter().flatten().map(|(p, _)| p).collect();
     }
     if points.is_empty() {
-        return Ok((Vec::new(), Vec::new(), 0));
+        return Ok(CapPoints::default());
     }
     let at = probe(&points)?;
     let far = far(&points)?;
@@ -125,27 +174,11 @@ pub fn cap_samples(
             normals.push(g.map(|x| x / gl));
         }
     }
-    let base = kept.len();
-    if base == 0 || area_per_sample.is_nan() || area_per_sample <= 0.0 {
-        return Ok((kept, normals, base));
-    }
     // The points dropped after the thinning take their share of the area with them.
-    area *= kept.len() as f64 / thinned as f64;
-    let share = area / kept.len() as f64;
-    let extra = ((share / area_per_sample).round() as usize).clamp(1, CAP_MAX_PER_POINT) - 1;
-    let disk = (share / std::f64::consts::PI).sqrt();
-    let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 7);
-    let (mut points, mut frames) = (kept.clone(), normals.clone());
-    for (p, n) in kept.iter().zip(&normals) {
-        let (u, v) = tangents(*n);
-        for _ in 0..extra {
-            let (rho, phi) = (disk * rng.uniform().sqrt(), std::f64::consts::TAU * rng.uniform());
-            let (a, b) = (rho * phi.cos(), rho * phi.sin());
-            points.push([0, 1, 2].map(|c| (p[c] + a * u[c] + b * v[c]).clamp(0.0, 1.0)));
-            frames.push(*n);
-        }
+    if thinned > 0 {
+        area *= kept.len() as f64 / thinned as f64;
     }
-    Ok((points, frames, base))
+    Ok(CapPoints { kept, normals, area })
 }
 
 /// Points on the caps' rims: the ring, [`CAP_CLEARANCE`] pair spacings wide, where a cap
@@ -387,7 +420,33 @@ pub(super) const CAP_MAX_PER_POINT: usize = 256;
 /// Spacing of the cap points kept for the further Newton steps, in pair spacings.
 pub(super) const CAP_THINNING: f64 = 0.5;
 
-/// [`cap_samples`] for the uniform part of `data`'s pool (its first `num_uniform` points),
+/// The pairs' spacing √(2A/K) the caps are found at, for the input's area `area` (unit
+/// frame) and K sites.
+pub(super) fn cap_spacing(area: f64, k: usize) -> f64 {
+    (2.0 * area / k as f64).sqrt()
+}
+
+/// [`cap_points`] of the uniform part of `data`'s pool (its first `num_uniform` points) at
+/// the pairs' spacing for the input's area `area` and K sites.
+///
+/// # Errors
+/// [`FitError::Occupancy`] when an oracle query fails.
+pub(super) fn pool_cap_points(
+    oracle: &MeshOracle,
+    data: &TrainingData,
+    num_uniform: usize,
+    area: f64,
+    k: usize,
+) -> Result<CapPoints, FitError> {
+    if k < 2 {
+        return Ok(CapPoints::default());
+    }
+    let spacing = cap_spacing(area, k);
+    cap_points(oracle, &data.points[..num_uniform.min(data.points.len())], spacing, CAP_THINNING * spacing)
+}
+
+/// The caps' samples ([`CapPoints`] of the uniform part of `data`'s pool, found by
+/// [`pool_cap_points`]) added to `data`'s surface samples,
 /// as dense as the surface samples (one per A/n of area, A the input's area). The points
 /// Newton put on the caps (half a pair spacing apart) go to seeded places among the first
 /// 12·K surface samples (the initialisation's candidates), with the samples they displace
@@ -406,7 +465,7 @@ pub(super) fn add_cap_samples(
     oracle: &MeshOracle,
     unit: &TriMesh,
     data: &mut TrainingData,
-    num_uniform: usize,
+    caps: CapPoints,
     area: f64,
     k: usize,
     seed: u64,
@@ -415,15 +474,8 @@ pub(super) fn add_cap_samples(
     if n == 0 || data.normals.len() != n || k < 2 {
         return Ok(0);
     }
-    let spacing = (2.0 * area / k as f64).sqrt();
-    let (points, normals, base) = cap_samples(
-        oracle,
-        &data.points[..num_uniform.min(data.points.len())],
-        spacing,
-        CAP_THINNING * spacing,
-        area / n as f64,
-        seed,
-    )?;
+    let spacing = cap_spacing(area, k);
+    let (points, normals, base) = caps.samples(area / n as f64, seed);
     let m = n.min(12 * k);
     let mut rng = ChunkRng::for_chunk(seed, Stream::SitesInit, 6);
     for (i, (&point, &normal)) in points.iter().zip(&normals).enumerate() {

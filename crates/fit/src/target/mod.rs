@@ -18,10 +18,11 @@ use occupancy::MeshOracle;
 use soft_voronoi::{FloodSolid, MeshSolid, ShellSolid, Solid, TrainingData};
 
 use crate::config::{
-    flood_sheet_half_thickness, shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE,
+    flood_sheet_half_thickness, shell_half_thickness, FitConfig, SolidRule, AMBIGUITY_SAMPLES, CAPS_SHELL_ABOVE,
+    SHELL_ABOVE,
 };
 use crate::error::{FitError, MeshFault};
-pub use crate::report::{BandTrial, FloodReport, SheetBand, SolidReport};
+pub use crate::report::{BandTrial, FloodReport, SheetBand, SolidReport, CHOSEN_FOR_LARGE_CAPS};
 
 /// The flood solid's report has a `sheet_band` when more than this share of the surface
 /// is sheets.
@@ -181,6 +182,7 @@ pub(crate) fn choose<'a>(
             interior_surface_share: None,
             interior_surface_samples_dropped: 0,
             cap_samples: 0,
+            cap_area_share: None,
             thickness_search: None,
             holes_filled: None,
             flood: Some(flood_report(f)),
@@ -200,10 +202,23 @@ pub(crate) fn choose<'a>(
     let near = &data.occupancy[num_uniform..];
     let share = near.iter().filter(|&&o| o).count() as f64 / near.len().max(1) as f64;
     let nothing_inside = !data.occupancy.iter().any(|&o| o);
-    let (rule, chosen_by) = match s.solid {
+    let (mut rule, mut chosen_by) = match s.solid {
         SolidRule::Auto if !is_closed && (ambiguous >= SHELL_ABOVE || nothing_inside) => (SolidRule::Shell, "auto"),
         SolidRule::Auto => (SolidRule::Winding, "auto"),
         r => (r, "--solid"),
+    };
+    // The winding solid of an open mesh is closed across its holes by |w| = 0.5 caps; where
+    // they would be a large part of the solid's surface, auto takes the shell
+    // ([`CAPS_SHELL_ABOVE`]).
+    let (caps, cap_area_share) = if rule == SolidRule::Winding && !is_closed && !nothing_inside {
+        let caps = pool_cap_points(oracle, data, num_uniform, sampler.total_area(), config.train.num_sites)?;
+        let share = caps.area() / sampler.total_area();
+        if s.solid == SolidRule::Auto && share >= CAPS_SHELL_ABOVE {
+            (rule, chosen_by) = (SolidRule::Shell, CHOSEN_FOR_LARGE_CAPS);
+        }
+        (Some(caps), share.is_finite().then_some(share))
+    } else {
+        (None, None)
     };
     if rule == SolidRule::Winding {
         if nothing_inside {
@@ -211,18 +226,17 @@ pub(crate) fn choose<'a>(
         }
         let solid = MeshSolid { oracle };
         let (interior, dropped) = drop_interior_surface(&solid, data, diagonal);
-        let caps = if is_closed {
-            0
-        } else {
-            add_cap_samples(
+        let caps = match caps {
+            Some(caps) => add_cap_samples(
                 oracle,
                 unit,
                 data,
-                num_uniform,
+                caps,
                 sampler.total_area(),
                 config.train.num_sites,
                 config.train.seed,
-            )?
+            )?,
+            None => 0,
         };
         let report = SolidReport {
             rule: SolidRule::Winding,
@@ -235,6 +249,7 @@ pub(crate) fn choose<'a>(
             interior_surface_share: Some(interior),
             interior_surface_samples_dropped: dropped,
             cap_samples: caps,
+            cap_area_share,
             thickness_search: None,
             holes_filled: None,
             flood: flood.as_ref().map(flood_report),
@@ -288,6 +303,7 @@ pub(crate) fn choose<'a>(
         interior_surface_share: None,
         interior_surface_samples_dropped: 0,
         cap_samples: 0,
+        cap_area_share,
         thickness_search,
         holes_filled: None,
         flood: flood.as_ref().map(flood_report),
