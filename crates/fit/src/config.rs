@@ -131,14 +131,14 @@ pub const SHELL_ABOVE: f64 = 0.5;
 /// [`SolidRule::Auto`] takes the shell for an open mesh whose winding-number solid would be
 /// closed by |w| = 0.5 caps of at least this share of the input's own area
 /// (`target::cap_points`' estimate; the report's `solid.cap_area_share`). A scan's holes
-/// are gaps in a surface that bounds a volume, and their caps a small part of it (on
-/// meshes not tuned on: the benchmark's camelhead, open at the neck, 6%; libigl's lion and
-/// face scans, open at the base and behind, 16–17%; the open teapots and bunny scan about
-/// 2%). A thin-walled part with large openings is not: libigl's halftunnel (two openings
-/// whose rims are not planar) 41%, a pipe without its ends 50%; closed by its caps,
-/// halftunnel's basin filled up and its crust stood 12.8% of the diagonal off the input,
-/// where its thin shell stands 0.94%. A sphere cut open a quarter of its height (25–27%)
-/// stays a volume.
+/// are gaps in a surface that bounds a volume, and their caps a small part of it
+/// (measured: the benchmark's camelhead, open at the neck, 6%; libigl's head bust
+/// `face.obj`, open at the neck, and lion's head, open behind, 16–17%; a soup of 100
+/// triangles 11%; the open teapot and the bunny scan 1–2%; a sphere open above a quarter
+/// of its height 22% at K = 2,048). A thin-walled part with large openings is not:
+/// libigl's halftunnel (two openings whose rims are not planar) 41%, a pipe without its
+/// ends 45% at K = 2,048. Closed by its caps, halftunnel's basin filled up and its crust
+/// stood 12.8% of the diagonal off the input, where its thin shell stands 0.94%.
 pub const CAPS_SHELL_ABOVE: f64 = 1.0 / 3.0;
 
 /// Near-surface samples whose winding number [`SolidRule::Auto`] looks at (the first ones
