@@ -677,12 +677,29 @@ impl AfterTraining<'_> {
             Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
             None => None,
         };
+        // A thin shell kept as constructed gets the solid guard alone (its band reaches past
+        // the box by its half-thickness): where the sheet bends sharper than the triplets'
+        // spacing (a terrain's peaks) an inside cell runs out of the band.
+        let shell_guard = match (config.carve, self.target) {
+            (Some(c), crate::target::Target::Shell(..)) if !config.train_shell => Some(c * self.diagonal),
+            _ => None,
+        };
+        if let (None, Some(threshold)) = (guard.as_ref(), shell_guard) {
+            let (box_lo, box_hi) = self.p.unit.bounding_box();
+            guard = Some(crate::guard::GuardReport { box_lo, box_hi, threshold, ..Default::default() });
+        }
+        let solid_threshold = guard_box.map(|g| g.2).or(shell_guard);
         // On the flood solid, the same cut across the solid's own surface where the crust
         // stands outside it (`guard::guard_solid`: the ModelNet airplane's wing fins, 6.5% of
         // the diagonal off the input). Not on the winding solid: measured there, it changed
         // nothing beyond noise but menger, which it made worse (docs/main-job.md).
-        let mut before_solid_guard = match (guard.as_mut(), guard_box, self.target) {
-            (Some(g), Some((_, _, threshold)), crate::target::Target::Flood(solid)) => {
+        let guarded: Option<&dyn soft_voronoi::Solid> = match self.target {
+            crate::target::Target::Flood(solid) => Some(solid),
+            crate::target::Target::Shell(solid, ..) => Some(solid),
+            crate::target::Target::Winding(_) => None,
+        };
+        let mut before_solid_guard = match (guard.as_mut(), solid_threshold, guarded) {
+            (Some(g), Some(threshold), Some(solid)) => {
                 let before = (sites.clone(), labels.clone(), Some(g.clone()));
                 let (per_round, from, to) = crate::guard::guard_solid(
                     &mut sites,

@@ -292,3 +292,40 @@ fn a_small_hole_stays_open_in_the_band() {
     assert_eq!((c.num_components, c.genus), (1, Some(1)), "{trials:?}");
     assert!(out.report.solid.half_thickness_of_diagonal.unwrap() < 0.5 * trials[0].half_thickness_of_diagonal);
 }
+
+/// A sheet with three sharp peaks (single vertices raised a quarter of its width, far
+/// steeper than the triplets' spacing resolves): inside cells at the peaks run out of the
+/// band into empty space (libigl-style terrains: spikes 6.5% of the diagonal off the
+/// input), and the solid guard cuts them at the band's side, so every crust vertex lies
+/// within the band and the carving tolerance of the sheet. Nothing within the band changes
+/// (the guard's own unit test).
+#[test]
+fn a_sheet_with_sharp_peaks_keeps_its_crust_on_the_band() {
+    let n = 24;
+    let mut mesh = sheet(n);
+    for (i, j) in [(6, 6), (12, 17), (18, 9)] {
+        mesh.positions[(j * (n + 1) + i) as usize][2] = 0.25;
+    }
+    let out = fit::fit(&mesh, &small("peaks"), &mut NoProgress).unwrap();
+    let s = &out.report.solid;
+    assert_eq!(s.rule, SolidRule::Shell);
+    let h = s.half_thickness.unwrap();
+    let g = out.report.guard.as_ref().expect("the shell is guarded");
+    let scale = out.report.transform.scale;
+    let threshold = g.threshold / scale;
+    // The peaks did run out of the band before the guard.
+    assert!(g.solid_beyond_before / scale > 2.0 * threshold, "{g:?}");
+    assert!(g.solid_mirrors_per_round.iter().sum::<usize>() > 0, "{g:?}");
+    assert!(g.solid_beyond_after < g.solid_beyond_before, "{g:?}");
+    let c = &out.report.crust;
+    assert!(c.is_closed && c.is_manifold, "{c:?}");
+    let oracle = occupancy::MeshOracle::new(&mesh.positions, &mesh.triangles, &occupancy::Config::default()).unwrap();
+    let far = oracle
+        .closest_points(&out.crust.positions)
+        .unwrap()
+        .iter()
+        .map(|c| c.squared_distance.sqrt())
+        .fold(0.0, f64::max);
+    assert!(far <= h + 2.0 * threshold, "a crust vertex {far} off the sheet (h = {h}, threshold {threshold})");
+    assert!(out.report.details().contains("tangent planes"), "{}", out.report.details());
+}

@@ -252,9 +252,11 @@ pub struct GuardReport {
     pub beyond_before: f64,
     /// After the last round.
     pub beyond_after: f64,
-    /// Flood solid only: outside sites added per round by `guard::guard_solid`, mirrors of
-    /// inside sites across the solid's tangent planes where the crust stood outside it
-    /// farther than `threshold` (empty for other solids).
+    /// Flood solid and thin shell kept as constructed only: outside sites added per round
+    /// by `guard::guard_solid`, mirrors of inside sites across the solid's tangent planes
+    /// where the crust stood outside it farther than `threshold` (empty for the winding
+    /// solid). On the shell, which has no box guard, the box fields are the box's and
+    /// nothing was added across it.
     pub solid_mirrors_per_round: Vec<usize>,
     /// How far the crust stood outside the solid before and after those rounds, unit-cube
     /// lengths (0 when they did not run).

@@ -267,12 +267,17 @@ impl FitReport {
 
     /// What the bounding-box guard and the solid guard added, when they added anything.
     fn guard_sentence(&self) -> String {
-        // Unit-cube lengths to shares of the diagonal, by the carving's ratio.
+        // Unit-cube lengths to shares of the diagonal, by the carving's ratio (or, on a thin
+        // shell kept as constructed, which is not carved, by its band's).
+        let by_band = match (self.solid.half_thickness, self.solid.half_thickness_of_diagonal) {
+            (Some(h), Some(f)) if h > 0.0 && self.transform.scale > 0.0 => f / (h * self.transform.scale),
+            _ => f64::NAN,
+        };
         let of_diag = self
             .carving
             .as_ref()
             .filter(|r| r.tolerance > 0.0)
-            .map_or(f64::NAN, |r| r.tolerance_of_diagonal / r.tolerance);
+            .map_or(by_band, |r| r.tolerance_of_diagonal / r.tolerance);
         let solid = match &self.guard {
             Some(g) if g.solid_mirrors_dropped.is_some() => {
                 " The solid guard's mirrors were taken back: the crust with them did not survive rounding to the \
