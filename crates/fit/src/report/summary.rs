@@ -391,12 +391,21 @@ impl FitReport {
                     }
                     None => String::new(),
                 };
+                let why = match (self.solid.chosen_by, self.solid.cap_area_share) {
+                    (super::CHOSEN_FOR_LARGE_CAPS, Some(share)) => format!(
+                        "The mesh is a thin-walled part with large openings (the |w| = 0.5 caps that would close its \
+                         winding-number solid would add {:.0}% to its area)",
+                        100.0 * share
+                    ),
+                    _ => format!(
+                        "The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
+                         and 0.75 in magnitude)",
+                        100.0 * self.solid.near_surface_ambiguous_share
+                    ),
+                };
                 format!(
-                    " The mesh is an open sheet ({:.0}% of near-surface samples have a winding number between 0.25 \
-                     and 0.75 in magnitude), so the sites fit a thin shell: the surface thickened by {:.4e} on each side ({:.2}% of the diagonal); the \
-                     crust is that shell's boundary.{search}",
-                    100.0 * self.solid.near_surface_ambiguous_share,
-                    h,
+                    " {why}, so the sites fit a thin shell: the surface thickened by {h:.4e} on each side ({:.2}% of the \
+                     diagonal); the crust is that shell's boundary.{search}",
                     100.0 * f
                 )
             }
