@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """How large the winding solid's caps would be on open meshes, and which solid
-`--solid auto` takes for them (`CAPS_SHELL_ABOVE`).
+`--solid auto` takes for them (`CAPS_SHELL_ABOVE`); with `--baseline-bin OLD`, the same
+fits by an older binary beside them (a before/after of one change).
 
     python3 benches/caps_share.py --bin target/release/voronoi-fit \\
         --out benches/results/caps_share.json \\
@@ -12,7 +13,9 @@ Each NAME=PATH runs the main job at its defaults (`NAME:winding=PATH` with
 why it was chosen, the caps' share of the input's area (`solid.cap_area_share`), the
 band's half-thickness and the sites it would need for τ (thin shell), and the four
 metrics against the input as given. Writes OUT (JSON, `rows`) and OUT.provenance.json
-(the command, the commit of the binary's tree, each input's SHA-256). Standard library only.
+(the command, the commit of the binary's tree, each input's SHA-256). With
+`--baseline-bin`, each row also has the older binary's figures as `FIELD_before` and the
+number of solid-guard mirrors of both (`mirrors`, `mirrors_before`). Standard library only.
 """
 import argparse
 import hashlib
@@ -56,6 +59,7 @@ def row(exe, name, path, work):
         "fscore": m["surface"]["fscore"],
         "normal_consistency": m["surface"]["normal_consistency"],
         "crust_closed": rep["crust"]["is_closed"],
+        "mirrors": sum((rep.get("guard") or {}).get("solid_mirrors_per_round") or []),
         "seconds": seconds,
     }
 
@@ -64,6 +68,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("meshes", nargs="+", help="NAME=PATH or NAME:winding=PATH")
     ap.add_argument("--bin", required=True)
+    ap.add_argument("--baseline-bin", help="an older binary run on the same meshes (fields FIELD_before)")
     ap.add_argument("--out", required=True)
     ap.add_argument("--source", action="append", default=[], help="NAME=where it comes from (provenance)")
     a = ap.parse_args()
@@ -79,6 +84,9 @@ def main():
                 "source": sources.get(name.split(":")[0], ""),
             }
             r = row(a.bin, name, path, work)
+            if a.baseline_bin:
+                old = row(a.baseline_bin, name, path, work)
+                r.update({f"{k}_before": v for k, v in old.items() if k not in ("mesh", "variant")})
             print(json.dumps(r), flush=True)
             rows.append(r)
     out = Path(a.out)
