@@ -354,7 +354,10 @@ def main():
                 w.writerows(rows)
         if not args.no_render:
             try:
-                rr = {k: dict(v, output=(ROOT / v["output"]) if v.get("output") else None) for k, v in mesh_rows.items()}
+                # Every method's row of this mesh whose output is still there (kept rows of
+                # an earlier run too), so a partial rerun keeps all columns of the render.
+                kept = {meth: v for (name, meth), v in done.items() if name == m["name"]}
+                rr = {k: dict(v, output=(ROOT / v["output"]) if v.get("output") else None) for k, v in kept.items()}
                 render(m, rr, out)
             except Exception as e:
                 print(f"    render failed: {e}", flush=True)

@@ -38,7 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from quality_meshes import load_mesh  # noqa: E402
 
 # azimuth (about the up axis) and elevation, degrees
-VIEWS = {"front": (-30.0, 20.0), "side": (60.0, 20.0), "top": (-30.0, 75.0), "back": (150.0, 20.0)}
+VIEWS = {"front": (-30.0, 20.0), "side": (60.0, 20.0), "top": (-30.0, 75.0), "back": (150.0, 20.0), "bottom": (-30.0, -60.0)}
 FRONT_COLOR = np.array([0.70, 0.76, 0.86])
 BACK_COLOR = np.array([0.95, 0.55, 0.20])
 LIGHT = np.array([-0.45, 0.65, 1.0]) / np.linalg.norm([-0.45, 0.65, 1.0])  # camera space
