@@ -121,9 +121,10 @@ pub struct Args {
     #[arg(long, default_value = "auto", value_parser = parse_solid)]
     pub solid: SolidRule,
     /// Thickness of the shell solid as a share of the bounding-box diagonal (`1%` or
-    /// `0.01`). Default: the thinnest of 0.3, 0.4, 0.5 and 0.7 times about one site spacing
-    /// whose crust keeps the topology and Hausdorff distance of the full spacing's, else
-    /// the full spacing (the report's `solid.thickness_search`).
+    /// `0.01`). Default: the thinnest of 0.15, 0.2, 0.3, 0.4, 0.5 and 0.7 times about one
+    /// site spacing whose crust keeps the topology and Hausdorff distance of the full
+    /// spacing's (none thinner when 0.7 breaks), else the full spacing (the report's
+    /// `solid.thickness_search`).
     #[arg(long, value_parser = parse_share)]
     pub shell_thickness: Option<f64>,
     /// Cells of the flood fill's grid along the longest side of the mesh (16 to 500,

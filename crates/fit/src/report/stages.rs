@@ -148,8 +148,10 @@ pub struct BandTrial {
     /// Its genus (summed over components; the crust is closed and manifold, so known).
     pub genus: Option<i64>,
     /// Upper end of its certified Hausdorff interval to the input, a fraction of the
-    /// diagonal.
-    pub hausdorff_of_diagonal: f64,
+    /// diagonal; `None` (null) for a thinner band whose components or genus already
+    /// differ from the default's (its distance does not change the choice, and is not
+    /// measured).
+    pub hausdorff_of_diagonal: Option<f64>,
     /// Whether this band was kept (the default's own row is kept when no thinner one
     /// passed).
     pub kept: bool,
