@@ -76,6 +76,19 @@ fn a_batch_records_bad_meshes_goes_on_and_reruns_skip_or_redo() {
             }
             assert!(r["hausdorff_of_diagonal"].parse::<f64>().unwrap() > 0.0, "{r:?}");
             assert!(r["triangles"].parse::<u64>().unwrap() > 0, "{r:?}");
+            // The solid fitted and why, per mesh; the closed meshes hold no band.
+            assert!(["winding", "shell", "flood"].contains(&r["solid"].as_str()), "{r:?}");
+            assert!(r["solid_chosen_by"].starts_with("auto"), "{r:?}");
+            if r["name"] != "soup" {
+                assert_eq!(
+                    (r["solid"].as_str(), r["band_half_thickness_of_diagonal"].as_str()),
+                    ("winding", ""),
+                    "{r:?}"
+                );
+            } else if r["solid"] == "winding" {
+                // An open mesh's winding solid has caps, and their share is given.
+                assert!(r["cap_area_share"].parse::<f64>().is_ok(), "{r:?}");
+            }
         } else {
             assert_eq!(r["status"], "bad input", "{r:?}");
             assert!(r["error"].contains(&r["name"]), "the error names the file: {r:?}");

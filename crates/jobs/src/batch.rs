@@ -469,7 +469,8 @@ pub fn run_batch(
 /// The header of `summary.csv`.
 pub const SUMMARY_HEADER: &str =
     "name,input,status,error,seconds,hausdorff_hi,hausdorff_of_diagonal,chamfer_l1,fscore,\
-normal_consistency,iou,misclassification,sites,triangles,components,genus,folder,occupancy";
+normal_consistency,iou,misclassification,sites,triangles,components,genus,folder,occupancy,\
+solid,solid_chosen_by,band_half_thickness_of_diagonal,holes_closed_flat,cap_area_share";
 
 /// One row of `summary.csv` before the report's figures are added.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -585,6 +586,20 @@ pub fn write_summary_rows(out: &Path, rows: &[SummaryRow], extra_columns: &[Stri
                 Some(f) if ok => csv(&dir.join(f).display().to_string()),
                 _ => String::new(),
             },
+            // Which solid was fitted and what it approximated: the rule and why, the band
+            // a sheet was thickened into (the thin shell's, or the flood solid's sheets'),
+            // the planar holes closed flat, and the caps' share of the area on an open mesh.
+            get(&["solid", "rule"]),
+            csv(&get(&["solid", "chosen_by"])),
+            match get(&["solid", "half_thickness_of_diagonal"]) {
+                h if !h.is_empty() => h,
+                _ if get(&["solid", "flood", "sheet_share"]).parse::<f64>().is_ok_and(|s| s > 0.0) => {
+                    get(&["solid", "flood", "sheet_half_thickness_of_diagonal"])
+                }
+                _ => String::new(),
+            },
+            get(&["solid", "holes_filled", "loops_filled"]),
+            get(&["solid", "cap_area_share"]),
         ];
         row.extend((0..extra_columns.len()).map(|k| csv(r.extra.get(k).map_or("", String::as_str))));
         text.push_str(&row.join(","));
@@ -635,8 +650,8 @@ mod tests {
         let text = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], SUMMARY_HEADER);
-        assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(13)));
-        assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(15)));
+        assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(18)));
+        assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(20)));
         // A runner's own columns go last.
         let mut row = SummaryRow::of(&jobs[1], None);
         row.extra = vec!["12".into()];
