@@ -689,10 +689,11 @@ impl AfterTraining<'_> {
             guard = Some(crate::guard::GuardReport { box_lo, box_hi, threshold, ..Default::default() });
         }
         let solid_threshold = guard_box.map(|g| g.2).or(shell_guard);
-        // On the flood solid, the same cut across the solid's own surface where the crust
-        // stands outside it (`guard::guard_solid`: the ModelNet airplane's wing fins, 6.5% of
-        // the diagonal off the input). Not on the winding solid: measured there, it changed
-        // nothing beyond noise but menger, which it made worse (docs/main-job.md).
+        // On the flood solid and the thin shell above, the same cut across the solid's own
+        // surface where the crust stands outside it (`guard::guard_solid`: the ModelNet
+        // airplane's wing fins, 6.5% of the diagonal off the input; a terrain's peaks). Not on
+        // the winding solid: measured there, it changed nothing beyond noise but menger, which
+        // it made worse (docs/main-job.md).
         let guarded: Option<&dyn soft_voronoi::Solid> = match self.target {
             crate::target::Target::Flood(solid) => Some(solid),
             crate::target::Target::Shell(solid, ..) => Some(solid),
