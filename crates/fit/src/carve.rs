@@ -87,7 +87,26 @@ pub fn carve(
     solid: &dyn Solid,
     options: &CarveOptions,
 ) -> Result<CarveReport, FitError> {
-    let CarveOptions { tolerance, rounds, max_new, mirrors, peels, gate } = *options;
+    carve_with(sites, labels, oracle, mesh, solid, options, &|_| options.gate)
+}
+
+/// [`carve`], the gate given by `first_surface` once the uncarved crust is measured: it is
+/// called with that crust's [`SurfaceBar`] and returns the bar to stop under (`None`: no
+/// gate), and `options.gate` is not used. The fit's two attempts running side by side pass
+/// the plain one's bar to the aligned one this way (`run.rs`).
+///
+/// # Errors
+/// As [`carve`].
+pub fn carve_with(
+    sites: &mut Vec<[f64; 3]>,
+    labels: &mut Vec<bool>,
+    oracle: &MeshOracle,
+    mesh: &TriMesh,
+    solid: &dyn Solid,
+    options: &CarveOptions,
+    first_surface: &dyn Fn(SurfaceBar) -> Option<SurfaceBar>,
+) -> Result<CarveReport, FitError> {
+    let CarveOptions { tolerance, rounds, max_new, mirrors, peels, gate: _ } = *options;
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
     let open_edges = mesh_io::topology::boundary_edges(mesh);
@@ -149,7 +168,7 @@ pub fn carve(
         if round == 0 {
             report.first_surface =
                 SurfaceBar { chamfer_l1: surface.chamfer_l1, normal_consistency: surface.normal_consistency };
-            if let Some(bar) = gate {
+            if let Some(bar) = first_surface(report.first_surface) {
                 // NaN compares false both ways: a NaN stops too.
                 let reaches =
                     surface.chamfer_l1 <= bar.chamfer_l1 && surface.normal_consistency >= bar.normal_consistency;

@@ -1,5 +1,7 @@
 //! The driver: [`fit`], one stage after another.
 
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 use crust::output::FrameMap;
@@ -14,7 +16,7 @@ use crate::config::{FitConfig, SolidRule, AMBIGUITY_SAMPLES, SHELL_ABOVE};
 use crate::crust_step::{crust_of, CheckedCrust};
 use crate::data::{compact, labelled_samples};
 use crate::error::{FitError, MeshFault};
-use crate::progress::{Progress, Stage};
+use crate::progress::{NoProgress, Progress, Stage};
 use crate::report::*;
 use crate::target;
 
@@ -119,6 +121,86 @@ struct Attempt {
     carving: Option<crate::carve::CarveReport>,
     pruning: Option<PruneReport>,
     checked: CheckedCrust,
+}
+
+/// An attempt's sites after its polish, before the crust stage.
+struct Polished {
+    sites: Vec<[f64; 3]>,
+    labels: Vec<bool>,
+    num_projected: usize,
+    polish: Option<soft_voronoi::PolishReport>,
+}
+
+/// What the aligned attempt running beside the plain one shares with it: its polish's
+/// progress (for the bar), a stop asked for on the plain side, and the plain crust's first
+/// measurement (its carving's gate).
+#[derive(Default)]
+struct Beside {
+    stop: AtomicBool,
+    polished: AtomicBool,
+    done: AtomicUsize,
+    loss_bits: AtomicU64,
+    gate: GateSlot,
+}
+
+/// The aligned attempt's outcome ([`AfterTraining::aligned_beside`]): its attempt (or why
+/// there is none), its metrics, its own seconds per stage and its wall seconds.
+struct Side {
+    result: Result<Result<Attempt, SurfaceBar>, FitError>,
+    metrics: Option<MetricsReport>,
+    timings: Timings,
+    seconds: f64,
+}
+
+/// The gate of carving ([`crate::carve::carve_with`]'s `first_surface`): called with the
+/// uncarved crust's figures, returns the bar to stop under.
+type Gate<'a> = &'a (dyn Fn(SurfaceBar) -> Option<SurfaceBar> + Sync);
+
+/// No gate: carving runs its rounds.
+const NO_GATE: Gate<'static> = &|_| None;
+
+/// The plain crust's uncarved figures, handed to the aligned attempt beside it: set once
+/// (the first carving's round 0, or `None` when the plain attempt ended without one),
+/// waited for by the aligned attempt's carving.
+#[derive(Default)]
+struct GateSlot {
+    value: Mutex<Option<Option<SurfaceBar>>>,
+    ready: std::sync::Condvar,
+}
+
+impl GateSlot {
+    /// Sets the value unless it is set.
+    fn publish(&self, bar: Option<SurfaceBar>) {
+        let mut v = self.value.lock().unwrap_or_else(|e| e.into_inner());
+        if v.is_none() {
+            *v = Some(bar);
+            self.ready.notify_all();
+        }
+    }
+
+    /// The value, once set.
+    fn wait(&self) -> Option<SurfaceBar> {
+        let mut v = self.value.lock().unwrap_or_else(|e| e.into_inner());
+        loop {
+            if let Some(bar) = *v {
+                return bar;
+            }
+            v = self.ready.wait(v).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+}
+
+impl Beside {
+    /// Records a finished step; `false` once a stop was asked for.
+    fn step(&self, done: usize, loss: f64) -> bool {
+        self.done.store(done, Ordering::Relaxed);
+        self.loss_bits.store(loss.to_bits(), Ordering::Relaxed);
+        !self.stop.load(Ordering::Relaxed)
+    }
+
+    fn loss(&self) -> f64 {
+        f64::from_bits(self.loss_bits.load(Ordering::Relaxed))
+    }
 }
 
 /// Hausdorff (certified upper end), Chamfer L1, F-score and normal consistency of a
@@ -324,7 +406,7 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
     let (chosen, measured, polish_choice) = after.polish_and_crust(progress, &mut clock)?;
     let crust_mesh = chosen.checked.written.mesh.clone();
     clock.timings.crust += clock.lap();
-    clock.timings.crust_parts = after.parts.get();
+    clock.timings.crust_parts = *after.parts.lock().unwrap_or_else(|e| e.into_inner());
 
     progress.stage(Stage::Evaluate);
     let quality = misclassification(&sampler, target.solid(), &chosen.sites, &chosen.labels, config, diagonal)?;
@@ -433,8 +515,8 @@ struct AfterTraining<'a> {
     /// Surface samples on the winding solid's caps (at the end of `data.surface`).
     cap_samples: usize,
     diagonal: f64,
-    /// Seconds of the crust stage's parts, summed over attempts.
-    parts: std::cell::Cell<CrustParts>,
+    /// Seconds of the crust stage's parts, summed over attempts (which may run side by side).
+    parts: Mutex<CrustParts>,
 }
 
 impl AfterTraining<'_> {
@@ -510,10 +592,13 @@ impl AfterTraining<'_> {
             && self.p.closed;
         // No gate is passed here, so every attempt below ends with a crust.
         let done = |a: Result<Attempt, SurfaceBar>| a.map_err(|_| FitError::Internal("carving stopped without a gate"));
+        if tries {
+            return self.plain_beside_aligned(progress, clock);
+        }
         let plain = if forced {
-            match self.attempt(true, None, progress, clock) {
+            match self.attempt(true, NO_GATE, progress, clock, None) {
                 Err(e) if e.is_input_fault() => {
-                    let mut a = done(self.attempt(false, None, progress, clock)?)?;
+                    let mut a = done(self.attempt(false, NO_GATE, progress, clock, None)?)?;
                     if let Some(pr) = a.polish.as_mut() {
                         pr.alignment_dropped = Some(e.to_string());
                     }
@@ -522,69 +607,164 @@ impl AfterTraining<'_> {
                 other => done(other?)?,
             }
         } else {
-            done(self.attempt(false, None, progress, clock)?)?
+            done(self.attempt(false, NO_GATE, progress, clock, None)?)?
         };
-        if tries {
-            self.try_aligned(plain, progress, clock)
-        } else {
-            Ok((plain, None, None))
-        }
+        Ok((plain, None, None))
     }
 
-    /// The default's second attempt on a closed input, with the alignment term, and the
-    /// choice between it and `plain` ([`choose_alignment`]).
-    fn try_aligned(
+    /// The default on a closed input: the plain attempt (polish, crust, metrics) on this
+    /// thread and the aligned one (polish, crust, metrics) on another beside it, then the
+    /// choice between the two ([`choose_alignment`]).
+    ///
+    /// The attempts share nothing but the trained sites and one figure: the aligned crust's
+    /// carving stops before its first round where its uncarved crust falls short of the
+    /// plain one's Chamfer distance or normal consistency, and waits for the plain one's
+    /// first measurement to know ([`GateSlot`]). A polish's result does not depend on the
+    /// threads that run it, so this is the serial order's result to the bit, while the
+    /// serial parts of one attempt (the crust's extraction and checks) run beside the other's.
+    /// The aligned attempt's parallel parts run in rayon's global pool.
+    fn plain_beside_aligned(
         &self,
-        plain: Attempt,
         progress: &mut dyn Progress,
         clock: &mut Clock,
     ) -> Result<(Attempt, Option<MetricsReport>, Option<PolishChoice>), FitError> {
-        let t_choice = Instant::now();
-        progress.stage(Stage::Metrics);
-        let plain_metrics = self.measure(&plain.checked.written.mesh);
-        clock.timings.metrics += clock.lap();
-        // Carving hardly moves a crust's Chamfer distance and normal consistency (it works
-        // where the Hausdorff distance is set), and the choice below asks for both to be no
-        // worse: an aligned crust that falls short of the plain one's on either before
-        // carving stops there, which spares its carving (on the Menger sponge, 7 of 8 rounds'
-        // worth of seconds).
-        let gate = plain.carving.as_ref().map(|r| r.first_surface);
-        let (aligned, aligned_error, stopped) = match self.attempt(true, gate, progress, clock) {
+        let pc = self.polish_config(true).ok_or(FitError::Internal("no polish to align"))?;
+        let beside = Beside::default();
+        let (plain, plain_metrics, side) = std::thread::scope(|scope| {
+            let side = scope.spawn(|| self.aligned_beside(&pc, &beside));
+            let publish = |bar: SurfaceBar| {
+                beside.gate.publish(Some(bar));
+                None
+            };
+            let plain = self.attempt(false, &publish, progress, clock, Some(&beside.stop));
+            // Whatever happened, the aligned attempt no longer waits for a gate.
+            beside.gate.publish(None);
+            let plain = match plain {
+                Ok(Ok(a)) => a,
+                other => {
+                    beside.stop.store(true, Ordering::Relaxed);
+                    return Err(match other {
+                        Err(e) => e,
+                        Ok(_) => FitError::Internal("carving stopped without a gate"),
+                    });
+                }
+            };
+            progress.stage(Stage::Metrics);
+            let plain_metrics = self.measure(&plain.checked.written.mesh);
+            clock.timings.metrics += clock.lap();
+            // What is left of the aligned attempt, its polish's progress shown and a stop
+            // passed on.
+            let mut shown = None;
+            while !side.is_finished() {
+                let polishing = !beside.polished.load(Ordering::Acquire);
+                let stage = if polishing { Stage::Polish } else { Stage::Crust };
+                if shown != Some(stage) {
+                    progress.stage(stage);
+                    shown = Some(stage);
+                }
+                if polishing {
+                    progress.polish_step(beside.done.load(Ordering::Relaxed), pc.steps, beside.loss());
+                }
+                if progress.should_stop() {
+                    beside.stop.store(true, Ordering::Relaxed);
+                }
+                std::thread::sleep(std::time::Duration::from_millis(10));
+            }
+            // The wait: the aligned attempt's own seconds are added below instead.
+            clock.lap();
+            let side = side.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            Ok((plain, plain_metrics, side))
+        })?;
+        let Side { result, metrics: aligned_metrics, timings, seconds } = side;
+        clock.timings.polish += timings.polish;
+        clock.timings.crust += timings.crust;
+        clock.timings.metrics += timings.metrics;
+        let (aligned, aligned_error, stopped) = match result {
             Ok(Ok(a)) => (Some(a), None, None),
             Ok(Err(bar)) => (None, None, Some(bar)),
+            Err(FitError::StoppedPolish { step, steps }) => return Err(self.stopped(step, steps)),
             Err(e) if e.is_input_fault() => (None, Some(e.to_string()), None),
             Err(e) => return Err(e),
         };
-        progress.stage(Stage::Metrics);
-        let aligned_metrics = aligned.as_ref().map(|a| self.measure(&a.checked.written.mesh));
-        clock.timings.metrics += clock.lap();
+        let gate = beside.gate.wait();
         let mut c = choose_alignment(&plain_metrics, aligned_metrics.as_ref(), aligned_error);
         c.before_carving = stopped.map(|aligned| BeforeCarving { plain: gate.unwrap_or_default(), aligned });
         let kept = c.aligned_kept;
-        let choice = Some(PolishChoice { seconds: t_choice.elapsed().as_secs_f64(), ..c });
+        let choice = Some(PolishChoice { seconds, ..c });
         match (kept, aligned, aligned_metrics) {
             (true, Some(a), Some(m)) => Ok((a, Some(m), choice)),
             _ => Ok((plain, Some(plain_metrics), choice)),
         }
     }
 
+    /// The aligned attempt beside the plain one ([`Self::plain_beside_aligned`]): its polish,
+    /// its crust (carving gated by the plain crust's first measurement, which it waits for)
+    /// and its metrics, with its own seconds per stage. A stop asked for on the plain side
+    /// stops its polish ([`FitError::StoppedPolish`]) and skips its crust.
+    fn aligned_beside(&self, pc: &soft_voronoi::PolishConfig, beside: &Beside) -> Side {
+        let t = Instant::now();
+        let mut clock = Clock::new();
+        let (mut sites, labels, num_projected) = self.trainer.final_sites();
+        let (data, k) = (self.data, self.trainer.config().num_sites);
+        let polish = soft_voronoi::polish::polish(
+            &mut sites,
+            k,
+            &data.surface,
+            Some((&labels, &data.normals)),
+            pc,
+            |done, _, loss| beside.step(done, loss),
+        );
+        clock.timings.polish += clock.lap();
+        beside.polished.store(true, Ordering::Release);
+        let stopped = |step| FitError::StoppedPolish { step, steps: pc.steps };
+        let result = match polish {
+            Err(e) => Err(FitError::Polish(e)),
+            Ok(report) if report.steps < pc.steps => Err(stopped(report.steps)),
+            Ok(_) if beside.stop.load(Ordering::Relaxed) => Err(stopped(pc.steps)),
+            Ok(report) => {
+                let polished = Polished { sites, labels, num_projected, polish: Some(report) };
+                self.crust_of_polished(polished, &|_| beside.gate.wait(), &mut NoProgress, &mut clock)
+            }
+        };
+        let metrics = match &result {
+            Ok(Ok(a)) => Some(self.measure(&a.checked.written.mesh)),
+            _ => None,
+        };
+        clock.timings.metrics += clock.lap();
+        Side { result, metrics, timings: clock.timings, seconds: t.elapsed().as_secs_f64() }
+    }
+
     /// Everything from the polish on, with or without the polish's alignment term.
-    /// `gate`: carving stops before its first round, and the attempt ends with the uncarved
-    /// crust's Chamfer distance and normal consistency (`Ok(Err(_))`), when that crust does
-    /// not reach them.
+    /// `gate`: called with the uncarved crust's Chamfer distance and normal consistency, it
+    /// returns the bar they must reach: where they do not, carving stops before its first
+    /// round and the attempt ends with them (`Ok(Err(_))`); [`NO_GATE`] for none.
+    /// `also_stop` is set when `progress` asks the polish to stop.
     fn attempt(
         &self,
         aligned: bool,
-        gate: Option<SurfaceBar>,
+        gate: Gate,
+        progress: &mut dyn Progress,
+        clock: &mut Clock,
+        also_stop: Option<&AtomicBool>,
+    ) -> Result<Result<Attempt, SurfaceBar>, FitError> {
+        progress.stage(Stage::Polish);
+        let (mut sites, labels, num_projected) = self.trainer.final_sites();
+        let polish = self.polish(&mut sites, &labels, aligned, progress, also_stop)?;
+        clock.timings.polish += clock.lap();
+        self.crust_of_polished(Polished { sites, labels, num_projected, polish }, gate, progress, clock)
+    }
+
+    /// The crust stage of an attempt: relabelling, guards, carving, pruning and the written
+    /// crust, from the polished sites; `gate` as in [`Self::attempt`].
+    fn crust_of_polished(
+        &self,
+        polished: Polished,
+        gate: Gate,
         progress: &mut dyn Progress,
         clock: &mut Clock,
     ) -> Result<Result<Attempt, SurfaceBar>, FitError> {
         let config = self.config;
-        progress.stage(Stage::Polish);
-        let (mut sites, mut labels, num_projected) = self.trainer.final_sites();
-        let polish = self.polish(&mut sites, &labels, aligned, progress)?;
-        clock.timings.polish += clock.lap();
-
+        let Polished { sites, mut labels, num_projected, polish } = polished;
         progress.stage(Stage::Crust);
         let num_relabelled = if config.relabel {
             relabel(&sites, &mut labels, self.trainer.config().num_sites, self.target.solid())
@@ -618,7 +798,38 @@ impl AfterTraining<'_> {
         labels: &[bool],
         aligned: bool,
         progress: &mut dyn Progress,
+        also_stop: Option<&AtomicBool>,
     ) -> Result<Option<soft_voronoi::PolishReport>, FitError> {
+        let Some(pc) = self.polish_config(aligned) else { return Ok(None) };
+        let k = self.trainer.config().num_sites;
+        let data = self.data;
+        let mut stopped = false;
+        let report = soft_voronoi::polish::polish(
+            sites,
+            k,
+            &data.surface,
+            Some((labels, &data.normals)),
+            &pc,
+            |done, total, loss| {
+                progress.polish_step(done, total, loss);
+                stopped = progress.should_stop() && done < total;
+                if let (true, Some(flag)) = (stopped, also_stop) {
+                    flag.store(true, Ordering::Relaxed);
+                }
+                !stopped
+            },
+        )
+        .map_err(FitError::Polish)?;
+        if stopped {
+            return Err(self.stopped(report.steps, pc.steps));
+        }
+        Ok(Some(report))
+    }
+
+    /// The settings of an attempt's polish, with or without the alignment term; `None` where
+    /// there is none (no polish asked for, or a thin shell: its sites are placed on the
+    /// shell's sides, not on the sampled surface).
+    fn polish_config(&self, aligned: bool) -> Option<soft_voronoi::PolishConfig> {
         let config = self.config;
         let data = self.data;
         match &config.polish {
@@ -632,19 +843,38 @@ impl AfterTraining<'_> {
                 pc.batch = pc.batch * data.surface.len().min(2 * input) / input;
                 pc.alignment =
                     if aligned { pc.alignment.clone().or_else(|| config.try_alignment.clone()) } else { None };
-                Ok(Some(polish(sites, labels, data, self.trainer, &pc, config, progress)?))
+                Some(pc)
             }
-            _ => Ok(None),
+            _ => None,
+        }
+    }
+
+    /// The error of a polish stopped at `step` of `steps` on request: with checkpointing,
+    /// the finished training's checkpoint is written (a resume redoes only the polish).
+    fn stopped(&self, step: usize, steps: usize) -> FitError {
+        let config = self.config;
+        let Some(c) = &config.checkpointing else { return FitError::StoppedPolish { step, steps } };
+        let trainer = self.trainer;
+        let written = config.checkpoint_context().and_then(|context| {
+            checkpoint::write(&c.path, trainer.state(), &context)
+                .map_err(|source| FitError::CheckpointWrite { path: c.path.clone(), source })
+        });
+        match written {
+            Ok(()) => {
+                let steps = trainer.config().steps;
+                FitError::Interrupted { step: steps, steps, checkpoint: c.path.clone() }
+            }
+            Err(e) => e,
         }
     }
 
     /// The guard, carving, pruning and the checked crust of relabelled sites; `Ok(Err(_))`
-    /// when carving's `gate` stopped it.
+    /// when carving's gate stopped it (`gate`: [`crate::carve::carve_with`]'s `first_surface`).
     fn carve_and_crust(
         &self,
         mut sites: Vec<[f64; 3]>,
         mut labels: Vec<bool>,
-        gate: Option<SurfaceBar>,
+        gate: Gate,
     ) -> Result<Result<Carved, SurfaceBar>, FitError> {
         let config = self.config;
         let places_sites = self.target.places_sites();
@@ -669,9 +899,7 @@ impl AfterTraining<'_> {
         // The report's `crust_parts`: seconds since the last lap added to one of them.
         let mut t = Lap::start();
         let mut add = |part: fn(&mut CrustParts) -> &mut f64| {
-            let mut parts = self.parts.get();
-            *part(&mut parts) += t.lap();
-            self.parts.set(parts);
+            *part(&mut self.parts.lock().unwrap_or_else(|e| e.into_inner())) += t.lap();
         };
         let mut guard = match guard_box {
             Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
@@ -733,12 +961,11 @@ impl AfterTraining<'_> {
                     let options = crate::carve::CarveOptions {
                         mirrors,
                         peels,
-                        gate,
                         ..crate::carve::CarveOptions::for_sites(tolerance, k)
                     };
                     let solid = self.target.solid();
-                    let mut r =
-                        crate::carve::carve(&mut sites, &mut labels, self.oracle, &self.p.unit, solid, &options)?;
+                    let (oracle, unit) = (self.oracle, &self.p.unit);
+                    let mut r = crate::carve::carve_with(&mut sites, &mut labels, oracle, unit, solid, &options, gate)?;
                     r.tolerance_of_diagonal = c;
                     r.mirrors_dropped = dropped.take();
                     Some(r)
@@ -869,49 +1096,6 @@ fn train<'a>(
     }
     progress.train_end();
     Ok(trainer)
-}
-
-/// Polishes the trained sites onto the surface samples ([`soft_voronoi::polish`]). A stop
-/// asked for during the polish writes the finished training's checkpoint (when
-/// checkpointing), so a resume redoes only the polish. `labels` are the sites' labels,
-/// for the alignment term.
-fn polish(
-    sites: &mut [[f64; 3]],
-    labels: &[bool],
-    data: &TrainingData,
-    trainer: &Trainer,
-    pc: &soft_voronoi::PolishConfig,
-    config: &FitConfig,
-    progress: &mut dyn Progress,
-) -> Result<soft_voronoi::PolishReport, FitError> {
-    let k = trainer.config().num_sites;
-    let mut stopped = false;
-    let report = soft_voronoi::polish::polish(
-        sites,
-        k,
-        &data.surface,
-        Some((labels, &data.normals)),
-        pc,
-        |done, total, loss| {
-            progress.polish_step(done, total, loss);
-            stopped = progress.should_stop() && done < total;
-            !stopped
-        },
-    )
-    .map_err(FitError::Polish)?;
-    if stopped {
-        let steps = trainer.config().steps;
-        return Err(match &config.checkpointing {
-            Some(c) => {
-                let context = config.checkpoint_context()?;
-                checkpoint::write(&c.path, trainer.state(), &context)
-                    .map_err(|source| FitError::CheckpointWrite { path: c.path.clone(), source })?;
-                FitError::Interrupted { step: steps, steps, checkpoint: c.path.clone() }
-            }
-            None => FitError::StoppedPolish { step: report.steps, steps: pc.steps },
-        });
-    }
-    Ok(report)
 }
 
 /// Gives each of the first `k` (trainable) sites the solid's label at its final position and

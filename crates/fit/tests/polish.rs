@@ -165,3 +165,44 @@ fn the_default_keeps_the_aligned_crust_only_where_no_metric_is_worse() {
     open.triangles.retain(|_| *k.next().unwrap());
     assert!(run(&open, "hemisphere", None).report.polish_choice.is_none());
 }
+
+/// The default's aligned attempt runs beside the plain one on another thread: the files are
+/// the same in a pool of one thread (a batch job's, `--jobs` as many as the cores) as on
+/// every core, and a stop asked for during the plain polish stops the fit with the polish's
+/// error once the aligned attempt beside it has stopped too.
+#[test]
+fn the_aligned_attempt_beside_the_plain_one_changes_nothing_and_stops_on_request() {
+    let mut c = config(true);
+    c.try_alignment = tried();
+    let mesh = cube();
+    let everywhere = fit::fit(&mesh, &c, &mut NoProgress).unwrap();
+    assert!(everywhere.report.polish_choice.is_some());
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let alone = one.install(|| fit::fit(&mesh, &c, &mut NoProgress).unwrap());
+    assert_eq!(alone.sites.sites, everywhere.sites.sites);
+    assert_eq!(alone.crust.positions, everywhere.crust.positions);
+    // The stages' seconds are each attempt's own, so on a closed input they add up to
+    // more than the wall time the two attempts took side by side.
+    let t = &everywhere.report.timings_seconds;
+    assert!(t.polish > 0.0 && t.crust > 0.0 && t.metrics > 0.0);
+
+    /// Asks to stop at the plain polish's 10th step.
+    #[derive(Default)]
+    struct StopInPolish {
+        steps: usize,
+    }
+    impl fit::Progress for StopInPolish {
+        fn polish_step(&mut self, _done: usize, _total: usize, _loss: f64) {
+            self.steps += 1;
+        }
+        fn should_stop(&mut self) -> bool {
+            self.steps >= 10
+        }
+    }
+    let mut progress = StopInPolish::default();
+    match fit::fit(&mesh, &c, &mut progress) {
+        Err(fit::FitError::StoppedPolish { step, steps }) => assert!(step == 10 && steps == 200, "{step} {steps}"),
+        Err(e) => panic!("stopped with {e}"),
+        Ok(_) => panic!("the fit ran to the end though a stop was asked for"),
+    }
+}

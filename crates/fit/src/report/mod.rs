@@ -90,6 +90,10 @@ pub struct Timings {
     pub metrics: f64,
     /// Where the crust stage's time went (summed over both attempts on a closed input; the
     /// rest of `crust` is relabelling and bookkeeping).
+    ///
+    /// On a closed input `polish`, `crust`, `metrics` and these parts are the two attempts'
+    /// own seconds summed; the attempts run side by side, so the stages add up to more
+    /// than the report's `total_seconds`.
     pub crust_parts: CrustParts,
 }
 
@@ -339,7 +343,8 @@ pub struct PolishChoice {
     pub aligned_kept: bool,
     /// The input's bounding-box diagonal (mesh units), for shares of it.
     pub diagonal: f64,
-    /// Wall time of the second polish, its crust and both measurements, seconds.
+    /// Wall time of the aligned attempt (its polish, crust and measurement), which runs
+    /// beside the plain one, seconds.
     pub seconds: f64,
 }
 
