@@ -45,7 +45,13 @@ def main():
     ap.add_argument("--baseline", help="another voronoi-fit binary to time on the same meshes")
     ap.add_argument("--meshes", help="comma-separated mesh paths (default: ../shared/meshes/* and assets/bunny.obj)")
     ap.add_argument("--json", help="write the measurements here")
+    ap.add_argument("--resummarize", metavar="JSON", help="only rewrite the summary of a file this script wrote")
     a = ap.parse_args()
+    if a.resummarize:
+        data = json.loads(Path(a.resummarize).read_text())
+        data["summary"] = summary(data["rows"])
+        Path(a.resummarize).write_text(json.dumps(data, indent=1))
+        return
     if a.meshes:
         meshes = [Path(m) for m in a.meshes.split(",")]
     else:
@@ -98,7 +104,25 @@ def flat(rows):
                 f[f"speedup_{s}"] = b["stages"][s] / max(r["new"]["stages"][s], 1e-9)
             f["baseline_misclassification"] = b["misclassification"]
         out.append(f)
-    return {"rows": out, "runs": rows}
+    return {"rows": out, "summary": summary(out), "runs": rows}
+
+
+def summary(flat_rows):
+    """Median and largest total seconds over the meshes, of the new build and the baseline."""
+    def of(field):
+        v = sorted(r[field] for r in flat_rows if field in r)
+        if not v:
+            return None
+        n = len(v)
+        return {"median": (v[(n - 1) // 2] + v[n // 2]) / 2, "max": v[-1]}
+
+    out = {"meshes": len(flat_rows)}
+    for prefix, field in [("", "total_s"), ("baseline_", "baseline_total_s")]:
+        s = of(field)
+        if s:
+            out[f"{prefix}median_total_s"] = s["median"]
+            out[f"{prefix}max_total_s"] = s["max"]
+    return out
 
 
 if __name__ == "__main__":
