@@ -87,13 +87,24 @@ pub fn carve(
     solid: &dyn Solid,
     options: &CarveOptions,
 ) -> Result<CarveReport, FitError> {
-    carve_with(sites, labels, oracle, mesh, solid, options, &|_| options.gate)
+    let start = Start { crust: None, first_surface: &|_| options.gate };
+    carve_with(sites, labels, oracle, mesh, solid, options, start)
 }
 
-/// [`carve`], the gate given by `first_surface` once the uncarved crust is measured: it is
-/// called with that crust's [`SurfaceBar`] and returns the bar to stop under (`None`: no
-/// gate), and `options.gate` is not used. The fit's two attempts running side by side pass
-/// the plain one's bar to the aligned one this way (`run.rs`).
+/// What [`carve_with`] starts from beyond the sites and the options.
+pub struct Start<'a> {
+    /// The crust of the sites and labels as given, when it was extracted already (the box
+    /// guard's last): the first round measures it instead of extracting it again. A crust
+    /// of another number of sites is not used.
+    pub crust: Option<Crust>,
+    /// The gate, once the uncarved crust is measured: called with that crust's
+    /// [`SurfaceBar`], it returns the bar to stop under (`None`: no gate); `options.gate`
+    /// is not used. The fit's two attempts running side by side pass the plain one's bar to
+    /// the aligned one this way (`run.rs`).
+    pub first_surface: &'a dyn Fn(SurfaceBar) -> Option<SurfaceBar>,
+}
+
+/// [`carve`], from [`Start`].
 ///
 /// # Errors
 /// As [`carve`].
@@ -104,8 +115,10 @@ pub fn carve_with(
     mesh: &TriMesh,
     solid: &dyn Solid,
     options: &CarveOptions,
-    first_surface: &dyn Fn(SurfaceBar) -> Option<SurfaceBar>,
+    start: Start,
 ) -> Result<CarveReport, FitError> {
+    let Start { crust: mut extracted, first_surface } = start;
+    extracted = extracted.filter(|c| c.stats.num_sites == sites.len());
     let CarveOptions { tolerance, rounds, max_new, mirrors, peels, gate: _ } = *options;
     let mut report = CarveReport { tolerance, ..Default::default() };
     let mut budget = max_new;
@@ -125,7 +138,7 @@ pub fn carve_with(
     // One function for all rounds (about 120 lines): each round's measurements, its
     // choice of strays and its insertions share the budget, the states and the report.
     for round in 0..=rounds {
-        let crust = match Crust::extract(sites, labels, &CrustConfig::default()) {
+        let crust = match extracted.take().map_or_else(|| Crust::extract(sites, labels, &CrustConfig::default()), Ok) {
             Ok(crust) => crust,
             // The sites with this round's insertions have no extractable crust (nearly
             // degenerate sites whose Voronoi vertices break it when rounded): take the

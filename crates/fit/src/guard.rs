@@ -44,12 +44,31 @@ pub fn guard(
     hi: [f64; 3],
     threshold: f64,
 ) -> Result<GuardReport, FitError> {
+    Ok(guard_keeping(sites, labels, lo, hi, threshold)?.0)
+}
+
+/// [`guard`], with the crust of the sites as it leaves them: every round ends with an
+/// extraction, and the guard stops before inserting anything after the last one, so
+/// carving's first round can start from it instead of extracting the same sites again.
+///
+/// # Errors
+/// As [`guard`].
+pub fn guard_keeping(
+    sites: &mut Vec<[f64; 3]>,
+    labels: &mut Vec<bool>,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    threshold: f64,
+) -> Result<(GuardReport, Crust), FitError> {
     let mut report = GuardReport { box_lo: lo, box_hi: hi, threshold, ..Default::default() };
     let beyond = |v: [f64; 3]| (0..3).fold(0.0f64, |m, k| m.max(lo[k] - v[k]).max(v[k] - hi[k]));
     let mut existing: std::collections::HashSet<[u64; 3]> = sites.iter().map(|p| p.map(f64::to_bits)).collect();
+    let mut last = None;
     for round in 0..=GUARD_ROUNDS {
-        let crust = Crust::extract(sites, labels, &CrustConfig::default())
-            .map_err(|source| FitError::Crust { during: "guarding the box", source })?;
+        let crust = last.insert(
+            Crust::extract(sites, labels, &CrustConfig::default())
+                .map_err(|source| FitError::Crust { during: "guarding the box", source })?,
+        );
         let far: Vec<[f64; 3]> = crust.mesh.positions.iter().copied().filter(|&v| beyond(v) > threshold).collect();
         let reach = crust.mesh.positions.iter().fold(0.0f64, |m, &v| m.max(beyond(v)));
         if round == 0 {
@@ -98,7 +117,9 @@ pub fn guard(
             break;
         }
     }
-    Ok(report)
+    // Every way out of the loop follows an extraction with nothing inserted after it.
+    let last = last.ok_or(FitError::Internal("the guard ran no round"))?;
+    Ok((report, last))
 }
 
 /// Rounds of [`guard_solid`] at most.

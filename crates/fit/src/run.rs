@@ -901,9 +901,15 @@ impl AfterTraining<'_> {
         let mut add = |part: fn(&mut CrustParts) -> &mut f64| {
             *part(&mut self.parts.lock().unwrap_or_else(|e| e.into_inner())) += t.lap();
         };
-        let mut guard = match guard_box {
-            Some((lo, hi, threshold)) => Some(crate::guard::guard(&mut sites, &mut labels, lo, hi, threshold)?),
-            None => None,
+        // The guard's last crust is of the sites as it leaves them: carving's first round
+        // measures it instead of extracting it again, unless the solid guard below adds
+        // sites (the first carving only: a retry extracts its own).
+        let (mut guard, mut extracted) = match guard_box {
+            Some((lo, hi, threshold)) => {
+                let (g, crust) = crate::guard::guard_keeping(&mut sites, &mut labels, lo, hi, threshold)?;
+                (Some(g), Some(crust))
+            }
+            None => (None, None),
         };
         // A thin shell kept as constructed gets the solid guard alone (its band reaches past
         // the box by its half-thickness): where the sheet bends sharper than the triplets'
@@ -939,6 +945,9 @@ impl AfterTraining<'_> {
                 )?;
                 let added = per_round.iter().sum::<usize>() > 0;
                 (g.solid_mirrors_per_round, g.solid_beyond_before, g.solid_beyond_after) = (per_round, from, to);
+                if added {
+                    extracted = None;
+                }
                 added.then_some(before)
             }
             _ => None,
@@ -965,7 +974,9 @@ impl AfterTraining<'_> {
                     };
                     let solid = self.target.solid();
                     let (oracle, unit) = (self.oracle, &self.p.unit);
-                    let mut r = crate::carve::carve_with(&mut sites, &mut labels, oracle, unit, solid, &options, gate)?;
+                    let start = crate::carve::Start { crust: extracted.take(), first_surface: gate };
+                    let mut r =
+                        crate::carve::carve_with(&mut sites, &mut labels, oracle, unit, solid, &options, start)?;
                     r.tolerance_of_diagonal = c;
                     r.mirrors_dropped = dropped.take();
                     Some(r)

@@ -74,6 +74,18 @@ fn pairs_at_the_feet_cut_a_spike_back() {
             assert_eq!((s, l), (sites.clone(), labels.clone()));
         }
     }
+    // Started from the crust of the same sites extracted already (the fit's box guard
+    // hands over its last one), carving does the same; a crust of other sites is not used.
+    let extracted = crust::Crust::extract(&start_sites, &start_labels, &crust::CrustConfig::default()).unwrap();
+    let fewer = crust::Crust::extract(&start_sites[1..], &start_labels[1..], &crust::CrustConfig::default()).unwrap();
+    for given in [extracted, fewer] {
+        let (mut s, mut l) = (start_sites.clone(), start_labels.clone());
+        let start = fit::carve::Start { crust: Some(given), first_surface: &|_| None };
+        let r = fit::carve::carve_with(&mut s, &mut l, &oracle, &unit, &solid, &options, start).unwrap();
+        assert_eq!((s, l), (sites.clone(), labels.clone()));
+        assert_eq!(r.farthest_per_round, report.farthest_per_round);
+        assert_eq!(r.first_surface, report.first_surface);
+    }
     let inserted: usize = report.inserted_per_round.iter().sum();
     assert_eq!(sites.len(), n0 + inserted);
     assert!(inserted > 0, "{report:?}");
