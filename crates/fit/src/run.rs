@@ -143,6 +143,16 @@ struct Beside {
     gate: GateSlot,
 }
 
+/// Stops the aligned attempt and releases it from its wait for the gate when dropped.
+struct Release<'a>(&'a Beside);
+
+impl Drop for Release<'_> {
+    fn drop(&mut self) {
+        self.0.stop.store(true, Ordering::Relaxed);
+        self.0.gate.publish(None);
+    }
+}
+
 /// The aligned attempt's outcome ([`AfterTraining::aligned_beside`]): its attempt (or why
 /// there is none), its metrics, its own seconds per stage and its wall seconds.
 struct Side {
@@ -636,13 +646,16 @@ impl AfterTraining<'_> {
                 beside.gate.publish(Some(bar));
                 None
             };
+            // Should this thread unwind (a panic), the aligned attempt is stopped and released
+            // from its wait for the gate, so that the scope's join can end.
+            let release = Release(&beside);
             let plain = self.attempt(false, &publish, progress, clock, Some(&beside.stop));
             // Whatever happened, the aligned attempt no longer waits for a gate.
             beside.gate.publish(None);
             let plain = match plain {
                 Ok(Ok(a)) => a,
                 other => {
-                    beside.stop.store(true, Ordering::Relaxed);
+                    drop(release);
                     return Err(match other {
                         Err(e) => e,
                         Ok(_) => FitError::Internal("carving stopped without a gate"),
@@ -672,6 +685,7 @@ impl AfterTraining<'_> {
             }
             // The wait: the aligned attempt's own seconds are added below instead.
             clock.lap();
+            drop(release); // the aligned attempt has finished: nothing left to stop
             let side = side.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
             Ok((plain, plain_metrics, side))
         })?;

@@ -206,3 +206,28 @@ fn the_aligned_attempt_beside_the_plain_one_changes_nothing_and_stops_on_request
         Ok(_) => panic!("the fit ran to the end though a stop was asked for"),
     }
 }
+
+/// A panic on the fit's own thread while the aligned attempt runs beside it (here, in the
+/// progress callback of the plain polish) reaches the caller instead of leaving the fit
+/// waiting for the aligned attempt, which would wait for the plain crust's gate forever.
+#[test]
+fn a_panic_beside_the_aligned_attempt_reaches_the_caller() {
+    let mut c = config(true);
+    c.try_alignment = tried();
+    struct PanicInPolish;
+    impl fit::Progress for PanicInPolish {
+        fn polish_step(&mut self, done: usize, _total: usize, _loss: f64) {
+            assert!(done < 5, "a progress callback that fails");
+        }
+    }
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let run = || fit::fit(&cube(), &c, &mut PanicInPolish).map(|_| ());
+        let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(run));
+        let _ = send.send(r.is_err());
+    });
+    match receive.recv_timeout(std::time::Duration::from_secs(300)) {
+        Ok(panicked) => assert!(panicked, "the fit returned though its progress callback panicked"),
+        Err(_) => panic!("the fit did not return within 300 s after a panic on its thread"),
+    }
+}
