@@ -214,6 +214,8 @@ fn the_aligned_attempt_beside_the_plain_one_changes_nothing_and_stops_on_request
 fn a_panic_beside_the_aligned_attempt_reaches_the_caller() {
     let mut c = config(true);
     c.try_alignment = tried();
+    // With carving, whose gate the aligned attempt waits for.
+    c.carve = fit::FitConfig::new("x", 8).carve;
     struct PanicInPolish;
     impl fit::Progress for PanicInPolish {
         fn polish_step(&mut self, done: usize, _total: usize, _loss: f64) {
