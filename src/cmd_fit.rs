@@ -137,6 +137,10 @@ pub struct Args {
     /// bottom); other holes are closed by the |winding number| = 0.5 surface.
     #[arg(long)]
     pub no_fill_holes: bool,
+    /// Train a thin shell's sites (and polish and carve them) instead of keeping them as
+    /// constructed, whose bisectors are the band's sides already; measured worse on sheets.
+    #[arg(long)]
+    pub train_shell: bool,
     /// Ask for an accuracy instead of a K: the certified Hausdorff distance to the input as
     /// a share of its bounding-box diagonal (`0.5%` or `0.005`). The fit starts at --sites
     /// and doubles K, refining where the error was, until met or --max-sites.
@@ -260,6 +264,7 @@ impl Args {
                 shell_thickness: self.shell_thickness,
                 flood_cells: self.flood_cells,
                 no_fill_holes: self.no_fill_holes,
+                train_shell: self.train_shell,
                 no_relabel: self.no_relabel,
                 carve: self.carve,
                 no_carve: self.no_carve,

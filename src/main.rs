@@ -44,7 +44,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// The main job: fit Voronoi sites to a mesh, write the crust, sites and report.
-    Fit(cmd_fit::Args),
+    Fit(Box<cmd_fit::Args>),
     /// The sphere study: Voronoi sites against OccNet / DeepSDF MLPs, Hausdorff distance
     /// against parameter count (results.csv, plot, table.md).
     Study(cmd_study::Args),
@@ -85,14 +85,14 @@ fn main() {
     };
     let command = match (cli.command, cli.fit) {
         (Some(c), _) => c,
-        (None, Some(fit)) => Command::Fit(fit),
+        (None, Some(fit)) => Command::Fit(Box::new(fit)),
         (None, None) => {
             eprintln!("error: give a mesh to fit (voronoi-fit MESH) or a subcommand; see voronoi-fit --help");
             std::process::exit(2);
         }
     };
     let result: Result<(), CliError> = match command {
-        Command::Fit(args) => cmd_fit::run(args),
+        Command::Fit(args) => cmd_fit::run(*args),
         Command::Study(args) => cmd_study::run(args),
         Command::Batch(args) => cmd_batch::run(args),
         Command::Mnist(args) => cmd_mnist::run(args),

@@ -211,8 +211,10 @@ pub struct FitConfig {
     /// Train the sites of a thin shell too. By default they are kept as constructed (see
     /// `target::shell_sites`): their bisectors are the shell's sides already, and training
     /// measured worse on sheets (near-surface misclassification 0.3 % as constructed,
-    /// 0.7–3 % after 600 steps at any learning rate tried). The CLI sets it when `--steps`
-    /// is given.
+    /// 0.7–3 % after 600 steps at any learning rate tried). `--train-shell` sets it; a
+    /// step count (`--steps`) alone does not, so a batch with its own steps keeps its
+    /// sheets as constructed (it once did: the quality benchmark's open sheet at `--steps
+    /// 150` went from F-score 1.000 to 0.000).
     pub train_shell: bool,
     /// Start from pairs refined where a previous fit's crust missed a tolerance (the
     /// accuracy target's rounds, `grow`); only with [`soft_voronoi::Init::Pairs`]

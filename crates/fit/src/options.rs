@@ -68,6 +68,9 @@ pub struct FitOptions {
     /// Keep an open mesh's planar holes open (default: closed flat before the
     /// winding-number solid is built, `mesh_io::fill_planar_holes`).
     pub no_fill_holes: bool,
+    /// Train a thin shell's sites too, and polish and carve them (default: kept as
+    /// constructed; [`FitConfig::train_shell`]).
+    pub train_shell: bool,
     /// Keep the training labels.
     pub no_relabel: bool,
     /// Carving tolerance as a fraction of the diagonal (default 0.3%).
@@ -119,7 +122,7 @@ impl FitOptions {
             c.sampling.flood_cells = n;
         }
         c.sampling.fill_holes = !self.no_fill_holes;
-        c.train_shell = self.steps.is_some();
+        c.train_shell = self.train_shell;
         // The paper preset is the paper's method: no polish, no relabelling, no insertion.
         c.relabel = !self.no_relabel && !paper;
         c.carve = if self.no_carve || (paper && self.carve.is_none()) { None } else { self.carve.or(c.carve) };

@@ -329,3 +329,28 @@ fn a_sheet_with_sharp_peaks_keeps_its_crust_on_the_band() {
     assert!(far <= h + 2.0 * threshold, "a crust vertex {far} off the sheet (h = {h}, threshold {threshold})");
     assert!(out.report.details().contains("tangent planes"), "{}", out.report.details());
 }
+
+/// Through the users' options (the CLI's flags, Python's keywords): a step count alone keeps
+/// a sheet's thin shell as constructed (a batch run with its own `--steps` once trained its
+/// sheets, and the quality benchmark's open sheet lost its F-score), `--train-shell` trains
+/// it.
+#[test]
+fn a_step_count_alone_keeps_the_shell_as_constructed() {
+    let run = |train_shell: bool| {
+        let o = fit::FitOptions {
+            sites: Some(1024),
+            steps: Some(40),
+            samples: Some(60_000),
+            eval_samples: Some(40_000),
+            skip_metrics: true,
+            train_shell,
+            ..Default::default()
+        };
+        fit::fit(&sheet(8), &o.to_config("sheet").unwrap(), &mut NoProgress).unwrap()
+    };
+    let kept = run(false);
+    assert_eq!(kept.report.solid.rule, fit::config::SolidRule::Shell);
+    assert_eq!(kept.report.settings.train.steps, 0, "kept as constructed");
+    let trained = run(true);
+    assert_eq!(trained.report.settings.train.steps, 40);
+}

@@ -66,6 +66,7 @@ _FIT_OPTIONS = {
     "solid",
     "shell_thickness",
     "no_fill_holes",
+    "train_shell",
     "skip_metrics",
     "polish_steps",
     "polish_lr",
@@ -332,7 +333,8 @@ def fit(
             ("default" | "fast" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell" | "flood"), shell_thickness, flood_cells,
-            no_fill_holes (keep planar holes open), skip_metrics,
+            no_fill_holes (keep planar holes open), train_shell (train a thin shell's sites
+            instead of keeping them as constructed), skip_metrics,
             polish_steps (0: no polish), polish_lr, polish_batch, polish_align (None: on a closed mesh both
             polishes, the aligned crust kept where it is at least as good on all four metrics,
             Hausdorff distances both within the F-score's tau or with overlapping certified

@@ -62,6 +62,7 @@ def fit(
     solid: Optional[str] = None,
     shell_thickness: Optional[float] = None,
     no_fill_holes: Optional[bool] = None,
+    train_shell: Optional[bool] = None,
     skip_metrics: Optional[bool] = None,
     polish_steps: Optional[int] = None,
     polish_lr: Optional[float] = None,
