@@ -19,7 +19,8 @@ pub struct Budget {
     /// Subdivisions of the icosphere the main job fits (vertices on the sphere; 6 gives
     /// 81,920 triangles, at most 1.2e-5 inside the sphere).
     pub icosphere_subdivisions: u32,
-    /// Training steps of the main job's schedule (`None`: its default, 600).
+    /// Training steps of the main job's schedule (`None`: its default, `fit::FitConfig::new`'s
+    /// `train.steps`, 200 today).
     pub voronoi_steps: Option<usize>,
     /// When a Voronoi fit's loss has not flattened (see [`crate::plateau::flattened`],
     /// windows of a tenth of the steps, 1%), it is run again with twice the steps, up to
