@@ -219,7 +219,8 @@ pub struct CarveReport {
     /// (from the samples of the F-score; unit-cube lengths).
     pub first_surface: SurfaceBar,
     /// Whether carving stopped before its first round because the uncarved crust did not
-    /// reach `carve::CarveOptions::gate`.
+    /// reach its gate (`carve::CarveOptions::gate`, or `carve::Start::first_surface`'s bar:
+    /// the plain crust's figures, for the aligned attempt beside it).
     pub gated: bool,
 }
 
