@@ -189,6 +189,37 @@ pub struct Checkpointing {
     pub every: usize,
 }
 
+/// What set the amount of a fit's work (report field `settings.work_set_by`): for the
+/// training pool's size, the training steps and the polish's steps and batch, the rule or
+/// the option that chose each. None of them follows the mesh yet: the pool is a fixed
+/// number of samples and the steps follow K and the preset.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct WorkSetBy {
+    /// `default` or `--samples`, `preset fast`.
+    pub samples: String,
+    /// `default`, `--steps`, `preset fast` or `preset paper`.
+    pub train_steps: String,
+    /// `default: K > 4096` (600 steps), `default: K <= 4096` (400), `--polish-steps` or
+    /// `preset fast`.
+    pub polish_steps: String,
+    /// `default` or `--polish-batch` (either grown by the caps' share of the surface
+    /// samples, at most twofold: the report's `polish.batch` is the one used).
+    pub polish_batch: String,
+}
+
+impl WorkSetBy {
+    /// The defaults' rules at `num_sites`.
+    pub fn defaults(num_sites: usize) -> Self {
+        let above = num_sites > soft_voronoi::polish::POLISH_STEPS_ABOVE;
+        WorkSetBy {
+            samples: "default".into(),
+            train_steps: "default".into(),
+            polish_steps: if above { "default: K > 4096" } else { "default: K <= 4096" }.into(),
+            polish_batch: "default".into(),
+        }
+    }
+}
+
 /// Everything that determines a fit of a given mesh.
 #[derive(Clone, Debug)]
 pub struct FitConfig {
@@ -247,6 +278,9 @@ pub struct FitConfig {
     /// [`soft_voronoi::polish::Alignment::default`] at weight [`TRY_ALIGNMENT_WEIGHT`]; `None`: the plain polish only
     /// (`--polish-align 0`).
     pub try_alignment: Option<soft_voronoi::polish::Alignment>,
+    /// What set the pool's size and the steps (the report's `settings.work_set_by`; the
+    /// front ends' options say when a flag or a preset did).
+    pub work_set_by: WorkSetBy,
 }
 
 impl FitConfig {
@@ -282,6 +316,7 @@ impl FitConfig {
                 normal_weight: TRY_ALIGNMENT_WEIGHT,
                 ..Default::default()
             }),
+            work_set_by: WorkSetBy::defaults(num_sites),
         }
     }
 

@@ -112,6 +112,24 @@ impl FitOptions {
         };
         let mut c = FitConfig::new(name, self.sites.unwrap_or(DEFAULT_SITES));
         let fast_samples = fast.then_some(FAST_SAMPLES);
+        let by = |given: bool, preset_sets: bool, default: &str| {
+            if given {
+                None
+            } else if preset_sets {
+                Some(format!("preset {preset}"))
+            } else {
+                Some(default.to_string())
+            }
+        };
+        let defaults = crate::config::WorkSetBy::defaults(c.train.num_sites);
+        c.work_set_by = crate::config::WorkSetBy {
+            samples: by(self.samples.is_some(), fast, &defaults.samples).unwrap_or("--samples".into()),
+            train_steps: by(self.steps.is_some(), fast || paper, &defaults.train_steps).unwrap_or("--steps".into()),
+            polish_steps: by(self.polish_steps.is_some(), fast, &defaults.polish_steps)
+                .unwrap_or("--polish-steps".into()),
+            polish_batch: by(self.polish_batch.is_some(), false, &defaults.polish_batch)
+                .unwrap_or("--polish-batch".into()),
+        };
         c.sampling.samples = self.samples.or(fast_samples).unwrap_or(c.sampling.samples);
         c.sampling.solid = self.solid;
         c.sampling.shell_thickness = self.shell_thickness;
@@ -168,6 +186,10 @@ impl FitOptions {
             }
             (p.steps > 0).then_some(p)
         };
+        if c.polish.is_none() {
+            let none = if paper && !self.no_polish { "preset paper: no polish" } else { "no polish" };
+            (c.work_set_by.polish_steps, c.work_set_by.polish_batch) = (none.into(), none.into());
+        }
         if c.polish.is_some() && self.no_relabel {
             return Err(FitError::Settings(
                 "--no-relabel needs --no-polish: the polish moves sites without looking at their labels, so after it \
@@ -218,5 +240,19 @@ mod tests {
         assert!(gp.alignment.is_some());
         let bad = FitOptions { preset: Some("quick".into()), ..Default::default() }.to_config("m");
         assert!(bad.unwrap_err().to_string().contains("`default`, `fast` or `paper`"));
+        // What set the work, as the report says.
+        let w = |c: &FitConfig| {
+            let w = &c.work_set_by;
+            [w.samples.clone(), w.train_steps.clone(), w.polish_steps.clone(), w.polish_batch.clone()]
+        };
+        assert_eq!(w(&default), ["default", "default", "default: K > 4096", "default"]);
+        assert_eq!(w(&fast), ["preset fast", "preset fast", "preset fast", "default"]);
+        assert_eq!(w(&given), ["--samples", "--steps", "--polish-steps", "default"]);
+        let small = config(FitOptions { sites: Some(1024), polish_batch: Some(5000), ..Default::default() });
+        assert_eq!(w(&small), ["default", "default", "default: K <= 4096", "--polish-batch"]);
+        let paper = config(FitOptions { preset: Some("paper".into()), ..Default::default() });
+        assert_eq!(w(&paper), ["default", "preset paper", "preset paper: no polish", "preset paper: no polish"]);
+        let none = config(FitOptions { no_polish: true, ..Default::default() });
+        assert_eq!(w(&none)[2], "no polish");
     }
 }

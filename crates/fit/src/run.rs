@@ -1075,6 +1075,7 @@ fn settings_report(state: &TrainState, config: &FitConfig, train_sigmas: Vec<f64
         eval_samples: config.eval.samples.max(2),
         resumed_from: config.resume.as_ref().map(|r| r.1.clone()),
         threads: rayon::current_num_threads(),
+        work_set_by: config.work_set_by.clone(),
     }
 }
 

@@ -56,6 +56,8 @@ pub struct SettingsReport {
     pub resumed_from: Option<String>,
     /// Worker threads.
     pub threads: usize,
+    /// What set the pool's size and the steps ([`crate::config::WorkSetBy`]).
+    pub work_set_by: crate::config::WorkSetBy,
 }
 
 /// The map from the input to the unit cube: u = (x − center)·scale + 0.5, as
