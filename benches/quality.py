@@ -19,6 +19,8 @@ Methods, per mesh and number of sites K (floats = 3K):
             the report's total_seconds (its fit-only part, without the report's own
             evaluation, is in `seconds_fit`). Storage 3K float32 + K bits; the fixed
             ceil(sqrt(K))-ish boundary sites are implied by K and not counted.
+  ours_uniform  the same with `--density uniform` (one pair spacing everywhere: the density
+            ablation's baseline, issue 53)
   voromesh  VoroMesh-style direct fit (benches/voromesh_ref.py: grid-initialised generators,
             VoroLoss, Adam, winding-number labels) with about K generators (exact count in
             `sites`), surface by `voronoi-fit crust` of its sites file. Same storage rule.
@@ -76,7 +78,7 @@ ROOT = HERE.parent
 TARGET = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
 WORK = ROOT / "target" / "quality-cache" / "runs"
 PY = sys.executable
-METHODS = ["ours", "voromesh", "mc", "qem"]
+METHODS = ["ours", "voromesh", "mc", "qem", "ours_uniform"]
 RENDER_DEFAULT = ["spot", "bunny_scan", "featuretype", "dragon", "box_fin", "cad_union"]
 TIMEOUT = 3600
 
@@ -113,9 +115,10 @@ def storage_bytes(K):
     return 12 * K + math.ceil(K / 8)
 
 
-def method_ours(mesh, K, d, a):
-    out = d / "ours.glb"
-    rep = json.loads(run([a.ours_bin, mesh.path, "-o", out, "--sites", K, "--quiet", "--json", *shlex.split(a.ours_args)]))
+def method_ours(mesh, K, d, a, extra=(), name="ours"):
+    out = d / f"{name}.glb"
+    rep = json.loads(run([a.ours_bin, mesh.path, "-o", out, "--sites", K, "--quiet", "--json",
+                          *shlex.split(a.ours_args), *extra]))
     t = rep["timings_seconds"]
     # Every site the file holds counts: K trained, the boundary sites, those inserted where
     # the crust strayed, less those removed last because they change nothing.
@@ -126,6 +129,13 @@ def method_ours(mesh, K, d, a):
         "seconds_fit": sum(t.get(k, 0.0) for k in ("load", "oracle", "sample", "train", "crust")),
         "notes": f"misclassified {100 * rep['quality']['misclassification']:.2f}%",
     }
+
+
+def method_ours_uniform(mesh, K, d, a):
+    """The main job with one pair spacing over the whole surface (`--density uniform`): the
+    density ablation's baseline (issue 53), in the same run as `ours`."""
+    out, row = method_ours(mesh, K, d, a, extra=["--density", "uniform"], name="ours_uniform")
+    return out, row
 
 
 def method_voromesh(mesh, K, d, a):
@@ -208,7 +218,8 @@ def method_qem(mesh, K, d, a):
                  "seconds_fit": wall, "notes": note}
 
 
-METHOD_FN = {"ours": method_ours, "voromesh": method_voromesh, "mc": method_mc, "qem": method_qem}
+METHOD_FN = {"ours": method_ours, "voromesh": method_voromesh, "mc": method_mc, "qem": method_qem,
+             "ours_uniform": method_ours_uniform}
 
 
 def evaluate(a, mesh, pred):
@@ -247,6 +258,7 @@ def settings_key(a, mesh, K, method):
     h.update(Path(mesh.path).read_bytes())
     extra = {
         "ours": a.ours_args + a.ours_bin_hash,
+        "ours_uniform": a.ours_args + a.ours_bin_hash,
         "voromesh": a.voromesh_args + file_hash(HERE / "voromesh_ref.py"),
     }.get(method, file_hash(__file__))  # mc, qem: this script's code
     h.update(f"{method}|{K}|{extra}|{a.bin_hash}".encode())

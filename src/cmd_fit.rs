@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use fit::{FitOptions, Progress, SolidRule};
-use soft_voronoi::{Init, StepStats};
+use soft_voronoi::{Density, Init, StepStats};
 
 use crate::cli_error::CliError;
 
@@ -44,6 +44,11 @@ pub struct Args {
     /// (uniform, half inside, half outside).
     #[arg(long)]
     pub init: Option<Init>,
+    /// Pair initialisation's density: `adaptive` (default: closer pairs where the part is
+    /// thinner or more folded than the uniform spacing, docs/main-job.md) or `uniform`
+    /// (one spacing everywhere; the ablation's baseline).
+    #[arg(long)]
+    pub density: Option<Density>,
     /// Training samples per step.
     #[arg(long)]
     pub batch: Option<usize>,
@@ -146,6 +151,11 @@ pub struct Args {
     /// and doubles K, refining where the error was, until met or --max-sites.
     #[arg(long, value_parser = parse_share)]
     pub target_hausdorff: Option<f64>,
+    /// Grow K as --target-hausdorff does (alone or with it) until the crust has the input's
+    /// genus and components: for a closed, manifold input fitted as its winding solid
+    /// without faces inside it (report: topology, accuracy_target).
+    #[arg(long)]
+    pub keep_topology: bool,
     /// Keep the training labels (default: after training every site takes the solid's label
     /// where it stands). Needs --no-polish: the polish moves sites without their labels.
     #[arg(long)]
@@ -188,7 +198,7 @@ pub struct Args {
     /// No surface polish after training.
     #[arg(long, conflicts_with_all = ["polish_steps", "polish_lr", "polish_batch", "polish_align"])]
     pub no_polish: bool,
-    /// Budget of sites for --target-hausdorff.
+    /// Budget of sites for --target-hausdorff and --keep-topology.
     #[arg(long, default_value_t = 131_072)]
     pub max_sites: usize,
     /// Also write OUT.points.npz: N occupancy samples of the fitted solid (labelled by the
@@ -249,6 +259,7 @@ impl Args {
                 seed: self.seed,
                 preset: Some(self.preset.clone()),
                 init: self.init,
+                density: self.density,
                 batch: self.batch,
                 lr: self.lr,
                 beta_start: self.beta_start,
@@ -279,6 +290,7 @@ impl Args {
             weld_tolerance: self.weld_tolerance,
             target_hausdorff: self.target_hausdorff,
             max_sites: self.max_sites,
+            keep_topology: self.keep_topology,
             checkpoint_every: self.checkpoint_every,
             resume: self.resume.clone(),
             stop_after: self.stop_after,

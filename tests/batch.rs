@@ -89,6 +89,13 @@ fn a_batch_records_bad_meshes_goes_on_and_reruns_skip_or_redo() {
                 // An open mesh's winding solid has caps, and their share is given.
                 assert!(r["cap_area_share"].parse::<f64>().is_ok(), "{r:?}");
             }
+            if r["name"] == "torus" {
+                // A clean closed input: its genus, and the crust's handles against it.
+                assert_eq!(r["input_genus"], "1", "{r:?}");
+                let closed: i64 = r["handles_closed"].parse().unwrap();
+                let added: i64 = r["handles_added"].parse().unwrap();
+                assert_eq!(closed - added, 1 - r["genus"].parse::<i64>().unwrap(), "{r:?}");
+            }
         } else {
             assert_eq!(r["status"], "bad input", "{r:?}");
             assert!(r["error"].contains(&r["name"]), "the error names the file: {r:?}");

@@ -172,6 +172,9 @@ def test_errors_are_input_errors_with_the_cli_message(bunny, tmp_path):
         vf.fit(bunny, progress=False, stepz=3)
     with pytest.raises(vf.InputError, match="at least twice"):
         vf.fit(bunny, progress=False, sites=512, samples=1000)
+    # Every documented option is passed through (an unknown one would fail first).
+    with pytest.raises(vf.InputError, match="at least twice"):
+        vf.fit(bunny, progress=False, sites=512, samples=1000, density="uniform", flood_cells=64)
     malformed = ROOT / "tests" / "malformed" / "nan_vertex.obj"
     cli = run("info", malformed, check=False)
     with pytest.raises(vf.InputError) as e:

@@ -1,7 +1,10 @@
 //! Asking for an accuracy instead of a K: [`fit_to_accuracy`] fits, measures the certified
 //! Hausdorff distance to the input, and refits with twice the sites, their pairs twice as
 //! dense again where the previous crust missed the target ([`Refine`]), until the target
-//! is met or the budget of sites is spent. The report's `accuracy_target` holds the trace.
+//! is met or the budget of sites is spent. The target can also (or only) ask for the
+//! input's topology: the crust's genus and components equal to the input's wherever the
+//! report can compare them (`keep_topology`; report field `topology`). The report's
+//! `accuracy_target` holds the trace.
 
 use mesh_io::TriMesh;
 
@@ -18,8 +21,11 @@ use crate::run::{fit, FitOutput};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AccuracyGoal {
     /// Upper end of the certified Hausdorff interval, as a fraction of the input's
-    /// bounding-box diagonal (e.g. 0.005 for 0.5 %).
-    pub hausdorff_of_diagonal: f64,
+    /// bounding-box diagonal (e.g. 0.005 for 0.5 %); `None`: no goal on it.
+    pub hausdorff_of_diagonal: Option<f64>,
+    /// Also ask for the input's genus and components where the report compares them
+    /// ([`crate::report::TopologyCheck`]; a fit without the check meets this part).
+    pub keep_topology: bool,
     /// Most sites to try (the sites double each round from the configuration's K).
     pub max_sites: usize,
 }
@@ -38,11 +44,13 @@ pub fn fit_to_accuracy(
     goal: &AccuracyGoal,
     progress: &mut dyn Progress,
 ) -> Result<FitOutput, FitError> {
-    let g = goal.hausdorff_of_diagonal;
-    if !(g.is_finite() && g > 0.0 && g < 1.0) {
+    if let Some(g) = goal.hausdorff_of_diagonal.filter(|g| !(g.is_finite() && *g > 0.0 && *g < 1.0)) {
         return Err(FitError::Settings(format!(
             "--target-hausdorff {g} must be in (0, 1) of the diagonal (e.g. 0.5%)"
         )));
+    }
+    if goal.hausdorff_of_diagonal.is_none() && !goal.keep_topology {
+        return Err(FitError::Settings("an accuracy target needs --target-hausdorff or --keep-topology".into()));
     }
     if goal.max_sites < config.train.num_sites {
         return Err(FitError::Settings(format!(
@@ -59,10 +67,16 @@ pub fn fit_to_accuracy(
     // Carving works on what lies farther apart than its tolerance; a goal under it (the
     // default 0.3% of the diagonal) would otherwise leave the error between the two to
     // growing K alone.
-    cfg.carve = cfg.carve.map(|c| c.min(g));
+    if let Some(g) = goal.hausdorff_of_diagonal {
+        cfg.carve = cfg.carve.map(|c| c.min(g));
+    }
+    // Where the next round's pairs are refined: farther than the goal from the input, or
+    // with a topology goal alone, farther than carving's tolerance.
+    let refine_at = goal.hausdorff_of_diagonal.or(cfg.carve).unwrap_or(crate::config::DEFAULT_CARVE);
     let mut trace = Vec::new();
-    // The fit with the least Hausdorff distance so far: (upper end, K, fit).
-    let mut best: Option<(f64, usize, FitOutput)> = None;
+    // The closest fit so far: (handles it differs by when the topology is asked for, upper
+    // end of the Hausdorff interval, K, fit), compared in that order.
+    let mut best: Option<(i64, f64, usize, FitOutput)> = None;
     loop {
         let t = std::time::Instant::now();
         let out = fit(input, &cfg, progress)?;
@@ -71,6 +85,11 @@ pub fn fit_to_accuracy(
             MetricsReport::Failed { error } => return Err(FitError::Measuring(error.clone())),
             MetricsReport::Skipped { .. } => unreachable!("metrics are always asked for here"),
         };
+        let topology = out.report.topology.clone();
+        // Handles and components the crust differs by from the input (0 where unchecked).
+        let off = topology.as_ref().map_or(0, |t| {
+            t.handles_closed + t.handles_added + (t.input_components as i64 - t.crust_components as i64).abs()
+        });
         trace.push(GrowthRow {
             sites: cfg.train.num_sites,
             hausdorff_lo_of_diagonal: lo,
@@ -78,21 +97,25 @@ pub fn fit_to_accuracy(
             misclassification: out.report.quality.misclassification,
             refined_share: out.report.refined_share.unwrap_or(0.0),
             seconds: t.elapsed().as_secs_f64(),
+            genus: out.report.crust.genus,
+            handles_closed: topology.as_ref().map(|t| t.handles_closed),
         });
-        let met = hi <= g;
+        let off = if goal.keep_topology { off } else { 0 };
+        let met = goal.hausdorff_of_diagonal.is_none_or(|g| hi <= g) && off == 0;
         let next = 2 * cfg.train.num_sites;
         // The fit returned when the goal is not met is the closest one, not the last:
         // doubling K need not lower the Hausdorff distance (the bundled bunny at a goal of
         // 0.15%: 0.220, 0.158 and 0.258% at 8,192, 16,384 and 32,768 sites). A fit that
         // meets the goal is always the closest so far.
         let previous = out.crust.clone();
-        if best.as_ref().is_none_or(|b| hi < b.0) {
-            best = Some((hi, cfg.train.num_sites, out));
+        if best.as_ref().is_none_or(|b| (off, hi) < (b.0, b.1)) {
+            best = Some((off, hi, cfg.train.num_sites, out));
         }
         if met || next > goal.max_sites {
-            let (_, sites_used, mut out) = best.expect("set above");
+            let (_, _, sites_used, mut out) = best.expect("set above");
             out.report.accuracy_target = Some(AccuracyReport {
-                goal_hausdorff_of_diagonal: g,
+                goal_hausdorff_of_diagonal: goal.hausdorff_of_diagonal,
+                keep_topology: goal.keep_topology,
                 max_sites: goal.max_sites,
                 met,
                 sites_used,
@@ -105,6 +128,6 @@ pub fn fit_to_accuracy(
         cfg.train.num_sites = next;
         cfg.train.lr *= shrink;
         cfg.train.lr_final *= shrink;
-        cfg.refine = Some(Refine { previous, tolerance: g * diagonal });
+        cfg.refine = Some(Refine { previous, tolerance: refine_at * diagonal });
     }
 }

@@ -3,7 +3,7 @@
 //! so the two front ends cannot drift apart.
 
 use serde::{Deserialize, Serialize};
-use soft_voronoi::{Init, TrainConfig};
+use soft_voronoi::{Density, Init, TrainConfig};
 
 use crate::config::{FitConfig, SolidRule, DEFAULT_SITES};
 use crate::error::FitError;
@@ -36,6 +36,8 @@ pub struct FitOptions {
     pub preset: Option<String>,
     /// Initialisation.
     pub init: Option<Init>,
+    /// How the pairs' density follows the shape (`adaptive`, the default, or `uniform`).
+    pub density: Option<Density>,
     /// Training samples per step.
     pub batch: Option<usize>,
     /// Initial learning rate (the cosine schedule keeps its final/initial ratio).
@@ -155,6 +157,7 @@ impl FitOptions {
         }
         t.steps = self.steps.unwrap_or(t.steps);
         t.init = self.init.unwrap_or(t.init);
+        t.density = self.density.unwrap_or(t.density);
         t.batch = self.batch.unwrap_or(t.batch);
         if let Some(lr) = self.lr {
             t.lr_final = if paper { lr } else { lr * (t.lr_final / t.lr) };

@@ -432,9 +432,12 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
 
     let state = trainer.state().clone();
     let Attempt { sites, labels, num_projected, polish, num_relabelled, guard, carving, pruning, checked } = chosen;
+    let input_block = input_report(input, &config.sampling.mesh, &p);
+    let crust_block = crust_report(&checked, &crust_mesh, num_projected);
+    let topology = topology_check(&input_block, &solid_report, &p, &crust_block);
     let report = FitReport {
         format_version: 1,
-        input: input_report(input, &config.sampling.mesh, &p),
+        input: input_block,
         settings: settings_report(&state, config, train_sigmas),
         solid: solid_report,
         transform: TransformReport { center: p.transform.center, scale: p.transform.scale },
@@ -442,7 +445,7 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
         losses: LossesReport::of(&state),
         quality,
         metrics,
-        crust: crust_report(&checked, &crust_mesh, num_projected),
+        crust: crust_block,
         refined_share,
         polish,
         polish_choice,
@@ -452,6 +455,7 @@ fn fit_once(input: &TriMesh, config: &FitConfig, progress: &mut dyn Progress) ->
         pruning,
         accuracy_target: None,
         iou_reference: Some(target.iou_reference()),
+        topology,
         outputs: OutputsReport::default(),
         total_seconds: t_all.elapsed().as_secs_f64(),
     };
@@ -1061,8 +1065,28 @@ fn input_report(input: &TriMesh, name: &str, p: &Prepared) -> InputReport {
         is_closed: p.topology.is_closed,
         is_manifold: p.topology.is_manifold,
         signed_volume: p.topology.signed_volume,
+        genus: input_genus(&p.topology, &p.reoriented),
         reoriented: p.reoriented.clone(),
     }
+}
+
+/// The genus of a closed, manifold, orientable surface from its Euler characteristic and
+/// components (χ = 2C − 2g), whatever its triangles' orientation (the reoriented mesh's is
+/// consistent where no piece is non-orientable); `None` for other surfaces.
+fn input_genus(t: &TopologyReport, reoriented: &mesh_io::Reorientation) -> Option<i64> {
+    let twice = 2 * t.num_components as i64 - t.euler_characteristic;
+    (t.is_closed && t.is_manifold && reoriented.non_orientable_pieces == 0 && twice % 2 == 0 && twice >= 0)
+        .then_some(twice / 2)
+}
+
+/// Report field `topology`: made where the input's genus is the solid's ([`TopologyCheck`]).
+fn topology_check(input: &InputReport, solid: &SolidReport, p: &Prepared, crust: &CrustReport) -> Option<TopologyCheck> {
+    let input_genus = input.genus?;
+    let crust_genus = crust.genus?;
+    let winding = solid.rule == crate::config::SolidRule::Winding;
+    let clean = solid.interior_surface_share.is_some_and(|s| s == 0.0);
+    (winding && clean && p.holes.is_none())
+        .then(|| TopologyCheck::new(input_genus, p.topology.num_components, crust_genus, crust.num_components))
 }
 
 /// Report field `settings`.

@@ -31,7 +31,7 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
     // A goal the first round misses (128 sites on a sphere: a few % of the diagonal).
     let first = fit::fit(&sphere, &small(128), &mut NoProgress).unwrap();
     let h0 = hausdorff_of(&first, &sphere);
-    let goal = AccuracyGoal { hausdorff_of_diagonal: 0.5 * h0, max_sites: 2048 };
+    let goal = AccuracyGoal { hausdorff_of_diagonal: Some(0.5 * h0), keep_topology: false, max_sites: 2048 };
     let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
     let a = out.report.accuracy_target.as_ref().expect("the trace");
     let sites: Vec<usize> = a.trace.iter().map(|r| r.sites).collect();
@@ -49,7 +49,7 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
     assert_eq!(a.sites_used, kept.sites);
     assert_eq!(out.report.settings.train.num_sites, kept.sites);
     assert_eq!(hausdorff_of(&out, &sphere), kept.hausdorff_hi_of_diagonal);
-    assert_eq!(a.met, last.hausdorff_hi_of_diagonal <= goal.hausdorff_of_diagonal);
+    assert_eq!(a.met, last.hausdorff_hi_of_diagonal <= goal.hausdorff_of_diagonal.unwrap());
     assert!(a.met || last.sites * 2 > goal.max_sites, "stopped early without meeting the goal");
     assert!(out.report.crust.is_closed && out.report.crust.is_manifold);
     assert!(out.report.details().contains("Accuracy target"));
@@ -60,7 +60,7 @@ fn grows_until_the_goal_is_met_and_reports_the_trace() {
 #[test]
 fn an_unreachable_goal_returns_the_closest_fit() {
     let sphere = icosphere(3);
-    let goal = AccuracyGoal { hausdorff_of_diagonal: 1e-6, max_sites: 512 };
+    let goal = AccuracyGoal { hausdorff_of_diagonal: Some(1e-6), keep_topology: false, max_sites: 512 };
     let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
     let a = out.report.accuracy_target.as_ref().expect("the trace");
     assert!(!a.met);
@@ -75,14 +75,15 @@ fn an_unreachable_goal_returns_the_closest_fit() {
 #[test]
 fn an_easy_goal_stops_at_the_first_round_and_bad_goals_are_refused() {
     let sphere = icosphere(2);
-    let goal = AccuracyGoal { hausdorff_of_diagonal: 0.5, max_sites: 1024 };
+    let goal = AccuracyGoal { hausdorff_of_diagonal: Some(0.5), keep_topology: false, max_sites: 1024 };
     let out = fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).unwrap();
     let a = out.report.accuracy_target.unwrap();
     assert!(a.met && a.trace.len() == 1 && a.sites_used == 128);
     for goal in [
-        AccuracyGoal { hausdorff_of_diagonal: 0.0, max_sites: 1024 },
-        AccuracyGoal { hausdorff_of_diagonal: f64::NAN, max_sites: 1024 },
-        AccuracyGoal { hausdorff_of_diagonal: 0.01, max_sites: 64 },
+        AccuracyGoal { hausdorff_of_diagonal: Some(0.0), keep_topology: false, max_sites: 1024 },
+        AccuracyGoal { hausdorff_of_diagonal: Some(f64::NAN), keep_topology: false, max_sites: 1024 },
+        AccuracyGoal { hausdorff_of_diagonal: Some(0.01), keep_topology: false, max_sites: 64 },
+        AccuracyGoal { hausdorff_of_diagonal: None, keep_topology: false, max_sites: 1024 },
     ] {
         assert!(fit_to_accuracy(&sphere, &small(128), &goal, &mut NoProgress).is_err_and(|e| e.is_input_fault()));
     }

@@ -470,7 +470,8 @@ pub fn run_batch(
 pub const SUMMARY_HEADER: &str =
     "name,input,status,error,seconds,hausdorff_hi,hausdorff_of_diagonal,chamfer_l1,fscore,\
 normal_consistency,iou,misclassification,sites,triangles,components,genus,folder,occupancy,\
-solid,solid_chosen_by,band_half_thickness_of_diagonal,holes_closed_flat,cap_area_share";
+solid,solid_chosen_by,band_half_thickness_of_diagonal,holes_closed_flat,cap_area_share,input_genus,\
+handles_closed,handles_added";
 
 /// One row of `summary.csv` before the report's figures are added.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -600,6 +601,11 @@ pub fn write_summary_rows(out: &Path, rows: &[SummaryRow], extra_columns: &[Stri
             },
             get(&["solid", "holes_filled", "loops_filled"]),
             get(&["solid", "cap_area_share"]),
+            // The crust's handles against the input's, where the report could compare them
+            // (a clean closed input fitted as its winding solid).
+            get(&["input", "genus"]),
+            get(&["topology", "handles_closed"]),
+            get(&["topology", "handles_added"]),
         ];
         row.extend((0..extra_columns.len()).map(|k| csv(r.extra.get(k).map_or("", String::as_str))));
         text.push_str(&row.join(","));

@@ -36,6 +36,9 @@ pub struct FitJob {
     pub target_hausdorff: Option<f64>,
     /// Budget of sites for `target_hausdorff`.
     pub max_sites: usize,
+    /// Grow K (as `target_hausdorff` does) until the crust has the input's genus and
+    /// components, where the report compares them.
+    pub keep_topology: bool,
     /// Write a checkpoint every this many steps (0: only when stopped).
     pub checkpoint_every: usize,
     /// Continue from this checkpoint (its settings are used; the mesh must be the same).
@@ -61,6 +64,7 @@ impl Default for FitJob {
             weld_tolerance: None,
             target_hausdorff: None,
             max_sites: 131_072,
+            keep_topology: false,
             checkpoint_every: 100,
             resume: None,
             stop_after: None,
@@ -207,12 +211,15 @@ pub fn fit_to_files(job: &FitJob, progress: &mut dyn Progress) -> Result<Written
         mesh_io::check_f32_resolution(&input, &job.mesh)?;
     }
     let mut progress = StopAfter { inner: progress, stop_after: job.stop_after, done_here: 0 };
-    let result = match job.target_hausdorff {
-        Some(h) => {
-            let goal = fit::AccuracyGoal { hausdorff_of_diagonal: h, max_sites: job.max_sites };
-            fit::fit_to_accuracy(&input, &config, &goal, &mut progress)
-        }
-        None => fit::fit(&input, &config, &mut progress),
+    let result = if job.target_hausdorff.is_some() || job.keep_topology {
+        let goal = fit::AccuracyGoal {
+            hausdorff_of_diagonal: job.target_hausdorff,
+            keep_topology: job.keep_topology,
+            max_sites: job.max_sites,
+        };
+        fit::fit_to_accuracy(&input, &config, &goal, &mut progress)
+    } else {
+        fit::fit(&input, &config, &mut progress)
     };
     let result = match result {
         Err(FitError::Interrupted { step, steps, checkpoint }) => {

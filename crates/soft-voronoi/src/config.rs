@@ -24,6 +24,33 @@ pub enum Init {
     Pairs,
 }
 
+/// How [`Init::Pairs`] spreads the K sites over the surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Density {
+    /// The default: closer pairs where the part is thinner, or the surface more folded, than
+    /// the uniform spacing (each pair's spacing capped at the largest of r0, r0/2, …,
+    /// r0/16 whose pair stays on its own sides of the solid), parts thinner than the pairs
+    /// rescued, the rest of the surface at the uniform spacing that keeps K
+    /// ([`crate::init::pairs_init`]).
+    #[default]
+    Adaptive,
+    /// One Poisson-disk spacing over the whole surface (the ablation's baseline): thin
+    /// parts and folds get no more pairs than flat faces.
+    Uniform,
+}
+
+impl std::str::FromStr for Density {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "adaptive" => Ok(Density::Adaptive),
+            "uniform" => Ok(Density::Uniform),
+            _ => Err(format!("unknown density '{s}' (expected 'adaptive' or 'uniform')")),
+        }
+    }
+}
+
 impl std::str::FromStr for Init {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
@@ -118,6 +145,9 @@ pub struct TrainConfig {
     /// [`Init::Surface`] and [`Init::Pairs`]: distance of each site from the surface, as a
     /// fraction of the (local) spacing of the pairs.
     pub surface_offset: f64,
+    /// [`Init::Pairs`]: how the pairs' density follows the shape ([`Density`]).
+    #[serde(default)]
+    pub density: Density,
     /// Adam's constants.
     pub adam: AdamParams,
     /// Seed of the initialisation and the batches.
@@ -169,6 +199,7 @@ impl TrainConfig {
             selection_batch: default_selection_batch(),
             init: Init::Pairs,
             surface_offset: 1.0,
+            density: Density::Adaptive,
             adam: AdamParams::default(),
             seed: 0,
         }

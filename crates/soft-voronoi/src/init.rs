@@ -3,6 +3,7 @@
 
 use vf_common::rng::{ChunkRng, Stream};
 
+use crate::config::Density;
 use crate::data::TrainingData;
 use crate::error::TrainError;
 use crate::kernel::SiteIndex;
@@ -179,9 +180,10 @@ pub fn pairs_init(
     data: &TrainingData,
     solid: &dyn Solid,
     offset: f64,
+    density: Density,
     seed: u64,
 ) -> Result<PairsInit, TrainError> {
-    pairs_init_refined(k, data, solid, offset, seed, &[])
+    pairs_init_refined(k, data, solid, offset, density, seed, &[])
 }
 
 /// [`pairs_init`] with pairs twice as dense where `refine` is true: `refine[i]` flags the
@@ -196,6 +198,7 @@ pub fn pairs_init_refined(
     data: &TrainingData,
     solid: &dyn Solid,
     offset: f64,
+    density: Density,
     seed: u64,
     refine: &[bool],
 ) -> Result<PairsInit, TrainError> {
@@ -209,7 +212,10 @@ pub fn pairs_init_refined(
     // A uniform spacing first, then a cap on each candidate's spacing where the part is
     // thinner (or the surface more folded) than the pairs would be wide there.
     let (_, r0) = poisson_subset(candidates, pairs);
-    let (mut cap, thin) = feature_caps(candidates, &data.normals[..m], solid, r0, offset);
+    let (mut cap, thin) = match density {
+        Density::Adaptive => feature_caps(candidates, &data.normals[..m], solid, r0, offset),
+        Density::Uniform => (vec![f64::INFINITY; m], vec![false; m]),
+    };
     for (c, _) in cap.iter_mut().zip(refine).filter(|(_, &r)| r) {
         *c = c.min(0.5 * r0);
     }

@@ -26,7 +26,7 @@ pub mod polish;
 pub mod solid;
 pub mod train;
 
-pub use config::{Init, TrainConfig, Weights};
+pub use config::{Density, Init, TrainConfig, Weights};
 pub use error::TrainError;
 pub use kernel::{Kernel, SiteIndex};
 pub use losses::{Located, SiteGraph, Solid};

@@ -29,6 +29,9 @@ pub struct InputReport {
     pub is_manifold: bool,
     /// Signed volume (input units³; origin-referenced for open meshes).
     pub signed_volume: f64,
+    /// Genus of the input surface (the sum over its components), when it is closed,
+    /// manifold and orientable; `null` otherwise.
+    pub genus: Option<i64>,
     /// Triangles turned to agree with their neighbours before the solid was built
     /// ([`mesh_io::orient_consistently`]): the winding-number solid is that of the
     /// consistently oriented mesh.
@@ -221,6 +224,51 @@ pub struct CrustReport {
     pub volume: f64,
 }
 
+/// Report field `topology`: the crust's handles against the input's. Made where the
+/// input's genus is the solid's: a closed, manifold, orientable input fitted as its
+/// winding-number solid with none of its surface inside the solid (no overlapping bodies or
+/// doubled faces, `solid.interior_surface_share` = 0; where bodies overlap the solid's
+/// genus is not the sum of theirs).
+///
+/// A handle closes where the hole through it is narrower than the sites can resolve (about
+/// two site spacings at this K); a handle is added where two parts closer than that are
+/// bridged.
+#[derive(Clone, Debug, Serialize)]
+pub struct TopologyCheck {
+    /// The input's genus.
+    pub input_genus: i64,
+    /// The crust's genus.
+    pub crust_genus: i64,
+    /// The input's connected components.
+    pub input_components: usize,
+    /// The crust's connected components.
+    pub crust_components: usize,
+    /// Handles of the input the crust does not have (input genus − crust genus, or 0).
+    pub handles_closed: i64,
+    /// Handles of the crust the input does not have (crust genus − input genus, or 0).
+    pub handles_added: i64,
+}
+
+impl TopologyCheck {
+    /// The check of a crust of genus `crust_genus` with `crust_components` components
+    /// against an input of `input_genus` and `input_components`.
+    pub fn new(input_genus: i64, input_components: usize, crust_genus: i64, crust_components: usize) -> Self {
+        TopologyCheck {
+            input_genus,
+            crust_genus,
+            input_components,
+            crust_components,
+            handles_closed: (input_genus - crust_genus).max(0),
+            handles_added: (crust_genus - input_genus).max(0),
+        }
+    }
+
+    /// Whether the crust has the input's genus and components.
+    pub fn kept(&self) -> bool {
+        self.input_genus == self.crust_genus && self.input_components == self.crust_components
+    }
+}
+
 /// Report field `pruning`: the sites removed last because every Delaunay neighbour
 /// carries their label, so neither the crust nor the nearest-site occupancy changes
 /// ([`crust::prune`]).
@@ -318,6 +366,9 @@ pub struct FitReport {
     /// input's winding number (`voronoi-fit eval` measures that one).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iou_reference: Option<String>,
+    /// The crust's genus against the input's, where the input's says what the solid's
+    /// should be (see [`TopologyCheck`]); absent otherwise.
+    pub topology: Option<TopologyCheck>,
     /// Files written (empty until a writer fills them in).
     pub outputs: OutputsReport,
     /// Wall time of the fit, seconds.

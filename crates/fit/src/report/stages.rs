@@ -300,19 +300,27 @@ pub struct GrowthRow {
     pub refined_share: f64,
     /// Wall time of the round, seconds.
     pub seconds: f64,
+    /// The crust's genus (when closed and manifold).
+    pub genus: Option<i64>,
+    /// Handles of the input the crust closed, where the report compares them (field
+    /// `topology`).
+    pub handles_closed: Option<i64>,
 }
 
 /// Report field `accuracy_target`.
 #[derive(Clone, Debug, Serialize)]
 pub struct AccuracyReport {
-    /// The goal, fraction of the diagonal.
-    pub goal_hausdorff_of_diagonal: f64,
+    /// The goal, fraction of the diagonal (`null`: none, the topology alone was asked for).
+    pub goal_hausdorff_of_diagonal: Option<f64>,
+    /// Whether the input's genus and components were asked for too (`--keep-topology`).
+    pub keep_topology: bool,
     /// The budget of sites.
     pub max_sites: usize,
     /// Whether the last round met the goal.
     pub met: bool,
     /// Sites of the returned fit: the round that met the goal, or when none did, the one
-    /// with the least Hausdorff distance.
+    /// with the least Hausdorff distance (with `keep_topology`: of those whose topology is
+    /// closest to the input's).
     pub sites_used: usize,
     /// Error against K, one row per round.
     pub trace: Vec<GrowthRow>,

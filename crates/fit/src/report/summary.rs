@@ -62,7 +62,7 @@ impl FitReport {
             "{}: fitted {} sites ({} more fixed on the boundary) in {} steps{}; on {} fresh samples {:.3}% are \
              misclassified (95% interval {:.3}–{:.3}%; {:.3}% of uniform, {:.3}% of near-surface ones).{}{}{}{} Crust of \
              {} sites ({} inside): {} triangles, {} component(s), \
-             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{}{} {}{}",
+             genus {}, closed, manifold and free of self-intersections (checked), volume {:.6e}.{}{}{} {}{}",
             self.input.path,
             t.num_sites,
             self.settings.train.num_boundary(),
@@ -89,6 +89,7 @@ impl FitReport {
             c.genus.map_or("n/a".to_string(), |g| g.to_string()),
             c.volume,
             crust::output::topology_note(c.topology_before_rounding).map_or(String::new(), |n| format!(" {n}")),
+            self.topology.as_ref().filter(|t| !t.kept()).map_or(String::new(), |t| t.difference()),
             shell,
             metrics,
             target
@@ -160,7 +161,16 @@ impl FitReport {
                 let other = if flat.is_empty() { "" } else { "other " };
                 format!("Solid: the winding-number volume |w| ≥ 0.5{flat}, {other}holes capped ({by})")
             }
-            None => format!("Solid: the winding-number volume |w| ≥ 0.5{flat} ({by})"),
+            None => {
+                // Where the crust's topology differs from the input's, the crust line's genus
+                // is read against this one (the details say how).
+                let genus = match self.topology.as_ref().filter(|t| !t.kept()) {
+                    Some(t) if t.input_genus != t.crust_genus => format!("; input genus {}", t.input_genus),
+                    Some(t) => format!("; input: {} component(s)", t.input_components),
+                    None => String::new(),
+                };
+                format!("Solid: the winding-number volume |w| ≥ 0.5{flat} ({by}){genus}")
+            }
         }
     }
 
@@ -529,11 +539,23 @@ impl FitReport {
                 let steps: Vec<String> = a
                     .trace
                     .iter()
-                    .map(|r| format!("{} sites: {:.3}%", r.sites, 100.0 * r.hausdorff_hi_of_diagonal))
+                    .map(|r| {
+                        let genus = match (a.keep_topology, r.genus) {
+                            (true, Some(g)) => format!(", genus {g}"),
+                            _ => String::new(),
+                        };
+                        format!("{} sites: {:.3}%{genus}", r.sites, 100.0 * r.hausdorff_hi_of_diagonal)
+                    })
                     .collect();
+                let goal = match (a.goal_hausdorff_of_diagonal, a.keep_topology) {
+                    (Some(g), false) => format!("Hausdorff ≤ {:.3}% of the diagonal", 100.0 * g),
+                    (Some(g), true) => {
+                        format!("Hausdorff ≤ {:.3}% of the diagonal and the input's topology", 100.0 * g)
+                    }
+                    (None, _) => "the input's topology".to_string(),
+                };
                 format!(
-                    " Accuracy target: Hausdorff ≤ {:.3}% of the diagonal {} {} sites (budget {}; {}).",
-                    100.0 * a.goal_hausdorff_of_diagonal,
+                    " Accuracy target: {goal} {} {} sites (budget {}; {}).",
                     if a.met { "met with" } else { "NOT met; the fit written is the closest one, with" },
                     a.sites_used,
                     a.max_sites,
@@ -617,5 +639,32 @@ fn taken_back(r: &super::CarveReport) -> String {
             .into()
     } else {
         String::new()
+    }
+}
+
+impl super::TopologyCheck {
+    /// For the details: how the crust's topology differs from the input's.
+    fn difference(&self) -> String {
+        let mut parts = Vec::new();
+        if self.handles_closed > 0 {
+            parts.push(format!(
+                "it closed {} of the input's {} handles (holes narrower than about two site spacings close; more \
+                 sites keep them)",
+                self.handles_closed, self.input_genus
+            ));
+        }
+        if self.handles_added > 0 {
+            parts.push(format!(
+                "it has {} handle(s) the input has not (parts closer than about two site spacings are bridged)",
+                self.handles_added
+            ));
+        }
+        if self.input_components != self.crust_components {
+            parts.push(format!(
+                "it has {} component(s) against the input's {}",
+                self.crust_components, self.input_components
+            ));
+        }
+        format!(" The crust's topology differs from the input's (genus {}): {}.", self.input_genus, parts.join("; "))
     }
 }

@@ -52,6 +52,7 @@ _FIT_OPTIONS = {
     "steps",
     "preset",
     "init",
+    "density",
     "batch",
     "lr",
     "beta_start",
@@ -65,6 +66,7 @@ _FIT_OPTIONS = {
     "eval_samples",
     "solid",
     "shell_thickness",
+    "flood_cells",
     "no_fill_holes",
     "train_shell",
     "skip_metrics",
@@ -330,7 +332,8 @@ def fit(
             ``voronoi-fit MESH`` writes); False keeps float64, as the CLI does for .obj and
             .ply outputs.
         **options: the CLI's other fit options by their long names: steps, preset
-            ("default" | "fast" | "paper"), init, batch, lr, beta_start, surface_offset, w_sdf,
+            ("default" | "fast" | "paper"), init, density ("adaptive" | "uniform"), batch, lr,
+            beta_start, surface_offset, w_sdf,
             w_centroidal, w_normal, w_reconstruction, w_surface, samples, eval_samples,
             solid ("auto" | "winding" | "shell" | "flood"), shell_thickness, flood_cells,
             no_fill_holes (keep planar holes open), train_shell (train a thin shell's sites
