@@ -656,8 +656,8 @@ mod tests {
         let text = std::fs::read_to_string(dir.path().join("summary.csv")).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], SUMMARY_HEADER);
-        assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(18)));
-        assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(20)));
+        assert_eq!(lines[1], format!("a,m/a.obj,bad input,m/a.obj: no volume,0.5{}", ",".repeat(21)));
+        assert_eq!(lines[2], format!("b_c,\"m/b,c.obj\",not run{}", ",".repeat(23)));
         // A runner's own columns go last.
         let mut row = SummaryRow::of(&jobs[1], None);
         row.extra = vec!["12".into()];
