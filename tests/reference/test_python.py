@@ -184,6 +184,26 @@ def test_errors_are_input_errors_with_the_cli_message(bunny, tmp_path):
         vf.fit(np.zeros((3, 3)), np.array([[0, 1, 2]]), progress=False, **SMALL)
 
 
+def test_the_accuracy_target_is_the_clis(bunny, tmp_path):
+    """`keep_topology`, `target_hausdorff` and `max_sites` reach the same accuracy target as
+    the CLI's flags: the same trace, K doubling from `sites`."""
+    r = vf.fit(bunny, name=str(BUNNY), progress=False, float32=False, keep_topology=True, target_hausdorff=0.004,
+               max_sites=1024, **SMALL)
+    a = r.report["accuracy_target"]
+    assert a["keep_topology"] and a["goal_hausdorff_of_diagonal"] == 0.004 and a["max_sites"] == 1024
+    sites = [row["sites"] for row in a["trace"]]
+    assert sites[0] == 512 and all(b == 2 * x for x, b in zip(sites, sites[1:])) and sites[-1] <= 1024
+    assert r.report["input"]["genus"] == 0 and "genus" in a["trace"][0]
+    out = tmp_path / "b.obj"
+    run(BUNNY, "-o", out, *SMALL_CLI, "--keep-topology", "--target-hausdorff", "0.4%", "--max-sites", "1024")
+    cli = json.loads(out.with_suffix(".report.json").read_text())["accuracy_target"]
+    assert [(t["sites"], t["genus"], t["hausdorff_hi_of_diagonal"]) for t in cli["trace"]] == [
+        (t["sites"], t["genus"], t["hausdorff_hi_of_diagonal"]) for t in a["trace"]
+    ]
+    with pytest.raises(vf.InputError, match="target-hausdorff"):
+        vf.fit(bunny, progress=False, target_hausdorff=2.0, **SMALL)
+
+
 def test_progress_callback_sees_every_step_and_can_stop(bunny):
     seen = []
     vf.fit(bunny, progress=lambda stage, step, steps, loss: seen.append((stage, step, steps)), **SMALL)

@@ -160,6 +160,29 @@ impl Progress for PyProgress {
     }
 }
 
+/// The accuracy target of a fit's options (`target_hausdorff`, `keep_topology`,
+/// `max_sites`, taken out of `json`), or `None` when neither goal is asked for.
+fn accuracy_goal(json: &mut serde_json::Map<String, serde_json::Value>) -> PyResult<Option<::fit::AccuracyGoal>> {
+    let bad = |what: &str, v: &serde_json::Value| input_error(format!("fit options: {what} = {v} is not valid"));
+    let hausdorff = match json.remove("target_hausdorff") {
+        None | Some(serde_json::Value::Null) => None,
+        Some(v) => Some(v.as_f64().ok_or_else(|| bad("target_hausdorff", &v))?),
+    };
+    let keep_topology = match json.remove("keep_topology") {
+        None | Some(serde_json::Value::Null) => false,
+        Some(v) => v.as_bool().ok_or_else(|| bad("keep_topology", &v))?,
+    };
+    let max_sites = match json.remove("max_sites") {
+        None | Some(serde_json::Value::Null) => 131_072,
+        Some(v) => v.as_u64().ok_or_else(|| bad("max_sites", &v))? as usize,
+    };
+    Ok((hausdorff.is_some() || keep_topology).then_some(::fit::AccuracyGoal {
+        hausdorff_of_diagonal: hausdorff,
+        keep_topology,
+        max_sites,
+    }))
+}
+
 type FitBytes<'py> =
     (Bound<'py, PyBytes>, Bound<'py, PyBytes>, Bound<'py, PyBytes>, Bound<'py, PyBytes>, Bound<'py, PyBytes>, String);
 
@@ -178,14 +201,22 @@ fn fit_mesh<'py>(
     float32: bool,
 ) -> PyResult<FitBytes<'py>> {
     let input = mesh(vertices, faces, name)?;
-    let options: FitOptions =
+    let mut json: serde_json::Map<String, serde_json::Value> =
         serde_json::from_str(options_json).map_err(|e| input_error(format!("fit options: {e}")))?;
+    // The accuracy target's three options are the job's, not `FitOptions`' (as on the CLI:
+    // `--target-hausdorff`, `--keep-topology`, `--max-sites`).
+    let goal = accuracy_goal(&mut json)?;
+    let options: FitOptions = serde_json::from_value(serde_json::Value::Object(json))
+        .map_err(|e| input_error(format!("fit options: {e}")))?;
     let mut config = options.to_config(name).map_err(input_error)?;
     // float64 unless asked: the CLI rounds (and checks again) at float32 only for glTF, and
     // so does `float32` here, for a crust that will be saved as GLB.
     config.output_precision = if float32 { ::crust::output::Precision::F32 } else { ::crust::output::Precision::F64 };
     let mut progress = PyProgress { callback, error: None, steps: 0 };
-    let result = py.allow_threads(|| ::fit::fit(&input, &config, &mut progress));
+    let result = py.allow_threads(|| match &goal {
+        Some(goal) => ::fit::fit_to_accuracy(&input, &config, goal, &mut progress),
+        None => ::fit::fit(&input, &config, &mut progress),
+    });
     if let Some(e) = progress.error.take() {
         return Err(e);
     }

@@ -74,6 +74,9 @@ _FIT_OPTIONS = {
     "polish_lr",
     "polish_batch",
     "polish_align",
+    "target_hausdorff",
+    "keep_topology",
+    "max_sites",
 }
 
 
@@ -342,7 +345,11 @@ def fit(
             polishes, the aligned crust kept where it is at least as good on all four metrics,
             Hausdorff distances both within the F-score's tau or with overlapping certified
             intervals counting as equal;
-            0: VoroLoss alone; W > 0: always weight W).
+            0: VoroLoss alone; W > 0: always weight W), target_hausdorff (a certified
+            Hausdorff distance as a share of the diagonal: K doubles from ``sites`` until
+            met), keep_topology (K doubles until the crust has the input's genus and
+            components), max_sites (their budget, default 131,072); the report's
+            ``accuracy_target`` has the trace.
 
     Returns:
         :class:`FitResult`.
