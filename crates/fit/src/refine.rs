@@ -55,7 +55,7 @@ pub(crate) fn refined_pairs(
     }
     let share = flags.iter().filter(|&&f| f).count() as f64 / m.max(1) as f64;
     let t = &config.train;
-    let (sites, labels, _) =
-        pairs_init_refined(k, data, solid, t.surface_offset, t.density, t.seed, &flags).map_err(FitError::TrainStart)?;
+    let (sites, labels, _) = pairs_init_refined(k, data, solid, t.surface_offset, t.density, t.seed, &flags)
+        .map_err(FitError::TrainStart)?;
     Ok((sites, labels, share))
 }

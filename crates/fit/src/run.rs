@@ -1080,7 +1080,12 @@ fn input_genus(t: &TopologyReport, reoriented: &mesh_io::Reorientation) -> Optio
 }
 
 /// Report field `topology`: made where the input's genus is the solid's ([`TopologyCheck`]).
-fn topology_check(input: &InputReport, solid: &SolidReport, p: &Prepared, crust: &CrustReport) -> Option<TopologyCheck> {
+fn topology_check(
+    input: &InputReport,
+    solid: &SolidReport,
+    p: &Prepared,
+    crust: &CrustReport,
+) -> Option<TopologyCheck> {
     let input_genus = input.genus?;
     let crust_genus = crust.genus?;
     let winding = solid.rule == crate::config::SolidRule::Winding;

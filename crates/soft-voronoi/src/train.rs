@@ -217,7 +217,8 @@ impl<'a> Trainer<'a> {
             Init::Samples => samples_init(k, data, config.seed)?,
             Init::Surface => surface_init(k, data, solid, config.surface_offset, config.seed)?,
             Init::Pairs => {
-                let (sites, labels, _) = pairs_init(k, data, solid, config.surface_offset, config.density, config.seed)?;
+                let (sites, labels, _) =
+                    pairs_init(k, data, solid, config.surface_offset, config.density, config.seed)?;
                 (sites, labels)
             }
         };
