@@ -199,7 +199,7 @@ pub struct Args {
     #[arg(long, conflicts_with_all = ["polish_steps", "polish_lr", "polish_batch", "polish_align"])]
     pub no_polish: bool,
     /// Budget of sites for --target-hausdorff and --keep-topology.
-    #[arg(long, default_value_t = 131_072)]
+    #[arg(long, default_value_t = fit::DEFAULT_MAX_SITES)]
     pub max_sites: usize,
     /// Also write OUT.points.npz: N occupancy samples of the fitted solid (labelled by the
     /// sites, i.e. inside the crust), in Occupancy Networks' layout (`points` float16 in the

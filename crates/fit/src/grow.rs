@@ -17,6 +17,9 @@ use crate::report::MetricsReport;
 pub use crate::report::{AccuracyReport, GrowthRow};
 use crate::run::{fit, FitOutput};
 
+/// Default budget of sites for an accuracy target (`--max-sites`).
+pub const DEFAULT_MAX_SITES: usize = 131_072;
+
 /// The accuracy asked for and the budget.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AccuracyGoal {
@@ -28,6 +31,18 @@ pub struct AccuracyGoal {
     pub keep_topology: bool,
     /// Most sites to try (the sites double each round from the configuration's K).
     pub max_sites: usize,
+}
+
+impl AccuracyGoal {
+    /// The goal of the front ends' options (`--target-hausdorff`, `--keep-topology`,
+    /// `--max-sites`), or `None` when neither goal is asked for (a plain fit).
+    pub fn asked(hausdorff_of_diagonal: Option<f64>, keep_topology: bool, max_sites: usize) -> Option<Self> {
+        (hausdorff_of_diagonal.is_some() || keep_topology).then_some(AccuracyGoal {
+            hausdorff_of_diagonal,
+            keep_topology,
+            max_sites,
+        })
+    }
 }
 
 /// Fits `input` with `config`'s K, then 2K, 4K, … up to `goal.max_sites`, each round's
@@ -85,11 +100,9 @@ pub fn fit_to_accuracy(
             MetricsReport::Failed { error } => return Err(FitError::Measuring(error.clone())),
             MetricsReport::Skipped { .. } => unreachable!("metrics are always asked for here"),
         };
-        let topology = out.report.topology.clone();
+        let topology = out.report.topology.as_ref();
         // Handles and components the crust differs by from the input (0 where unchecked).
-        let off = topology.as_ref().map_or(0, |t| {
-            t.handles_closed + t.handles_added + (t.input_components as i64 - t.crust_components as i64).abs()
-        });
+        let off = topology.map_or(0, |t| t.off_by());
         trace.push(GrowthRow {
             sites: cfg.train.num_sites,
             hausdorff_lo_of_diagonal: lo,
@@ -98,7 +111,7 @@ pub fn fit_to_accuracy(
             refined_share: out.report.refined_share.unwrap_or(0.0),
             seconds: t.elapsed().as_secs_f64(),
             genus: out.report.crust.genus,
-            handles_closed: topology.as_ref().map(|t| t.handles_closed),
+            handles_closed: topology.map(|t| t.handles_closed),
         });
         let off = if goal.keep_topology { off } else { 0 };
         let met = goal.hausdorff_of_diagonal.is_none_or(|g| hi <= g) && off == 0;

@@ -42,7 +42,7 @@ pub use config::{
 };
 pub use crust_step::{crust_of, CheckedCrust};
 pub use error::{FitError, MeshFault};
-pub use grow::{fit_to_accuracy, AccuracyGoal};
+pub use grow::{fit_to_accuracy, AccuracyGoal, DEFAULT_MAX_SITES};
 pub use options::FitOptions;
 pub use progress::{NoProgress, Progress, Stage};
 pub use report::FitReport;

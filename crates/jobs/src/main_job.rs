@@ -63,7 +63,7 @@ impl Default for FitJob {
             options: FitOptions::default(),
             weld_tolerance: None,
             target_hausdorff: None,
-            max_sites: 131_072,
+            max_sites: fit::DEFAULT_MAX_SITES,
             keep_topology: false,
             checkpoint_every: 100,
             resume: None,
@@ -211,15 +211,9 @@ pub fn fit_to_files(job: &FitJob, progress: &mut dyn Progress) -> Result<Written
         mesh_io::check_f32_resolution(&input, &job.mesh)?;
     }
     let mut progress = StopAfter { inner: progress, stop_after: job.stop_after, done_here: 0 };
-    let result = if job.target_hausdorff.is_some() || job.keep_topology {
-        let goal = fit::AccuracyGoal {
-            hausdorff_of_diagonal: job.target_hausdorff,
-            keep_topology: job.keep_topology,
-            max_sites: job.max_sites,
-        };
-        fit::fit_to_accuracy(&input, &config, &goal, &mut progress)
-    } else {
-        fit::fit(&input, &config, &mut progress)
+    let result = match fit::AccuracyGoal::asked(job.target_hausdorff, job.keep_topology, job.max_sites) {
+        Some(goal) => fit::fit_to_accuracy(&input, &config, &goal, &mut progress),
+        None => fit::fit(&input, &config, &mut progress),
     };
     let result = match result {
         Err(FitError::Interrupted { step, steps, checkpoint }) => {

@@ -173,14 +173,10 @@ fn accuracy_goal(json: &mut serde_json::Map<String, serde_json::Value>) -> PyRes
         Some(v) => v.as_bool().ok_or_else(|| bad("keep_topology", &v))?,
     };
     let max_sites = match json.remove("max_sites") {
-        None | Some(serde_json::Value::Null) => 131_072,
+        None | Some(serde_json::Value::Null) => ::fit::DEFAULT_MAX_SITES,
         Some(v) => v.as_u64().ok_or_else(|| bad("max_sites", &v))? as usize,
     };
-    Ok((hausdorff.is_some() || keep_topology).then_some(::fit::AccuracyGoal {
-        hausdorff_of_diagonal: hausdorff,
-        keep_topology,
-        max_sites,
-    }))
+    Ok(::fit::AccuracyGoal::asked(hausdorff, keep_topology, max_sites))
 }
 
 type FitBytes<'py> =

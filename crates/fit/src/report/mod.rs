@@ -263,9 +263,14 @@ impl TopologyCheck {
         }
     }
 
+    /// Handles and components the crust differs by from the input (0: kept).
+    pub fn off_by(&self) -> i64 {
+        self.handles_closed + self.handles_added + (self.input_components as i64 - self.crust_components as i64).abs()
+    }
+
     /// Whether the crust has the input's genus and components.
     pub fn kept(&self) -> bool {
-        self.input_genus == self.crust_genus && self.input_components == self.crust_components
+        self.off_by() == 0
     }
 }
 
